@@ -1,0 +1,313 @@
+"""VesselMotion: waves → 6-DOF motion → IMU and GNSS signals, with exact truth.
+
+Everything is one analytic sum of sinusoids per DOF (:class:`~marinefmu.sea.vessel.MotionSeries`),
+so position, velocity, acceleration, Euler angles, body rates and angular accelerations are
+exact derivatives of each other, and the sensors see those plus only their configured errors.
+
+Kinematics of a point P at body lever arm l (relative to the COG) with the reference point O
+at body lever arm c (c = 0 in RAO mode, c = CR in independent-rotation mode):
+
+.. math::
+    p_n = r_O + R_{nb}(l - c),\\quad
+    v_n = \\dot r_O + R_{nb}(ω × (l - c)),\\quad
+    a_n = \\ddot r_O + R_{nb}(α × (l - c) + ω × (ω × (l - c)))
+
+and the IMU reads f_b = R_nbᵀ (a_n − g_n). Translations are those of the seakeeping frame
+that moves with the vessel's mean forward speed (NED axes, origin at the reference point's
+mean position, mean heading north).
+
+Motion modes (``vessel.mode``):
+
+0. RAO response: all six DOFs from one wave realisation, referenced to the COG.
+1. Independent rotations: translations of the rotation centre ``vessel.cr`` and the rotations
+   are driven by independent random phase sets (same spectra), so the CR's acceleration is
+   statistically independent of the rotations: the known truth for paper 002's estimator.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, check_choice, check_int, check_vector
+from ..frames import attitude_kinematics, rigid_point_operator, specific_force
+from ..interface import Variable, real, vec
+from .sensors import ANTENNAS, Gnss, GnssParams, Imu, ImuParams
+from .vessel import PRESETS, MotionSeries, RaoTable, check_speed, load_rao_csv, preset_raos
+from .waves import SPECTRA, SeaState, realise
+
+MODES = {0: "RAO response about the COG", 1: "independent rotations about vessel.cr"}
+
+PARAMETERS: list[Variable] = [
+    real("sea.hs", 2.5, "m", "Significant wave height Hs, 0 < Hs <= 30"),
+    real("sea.tp", 9.0, "s", "Peak period Tp, 1 <= Tp <= 40"),
+    real("sea.gamma", 3.3, "", "JONSWAP peak enhancement factor, 1 <= gamma <= 10"),
+    Variable("sea.spectrum", "string", "jonswap", "", f"Wave spectrum: one of {', '.join(SPECTRA)}"),
+    real("sea.heading", math.pi, "rad", "Mean wave travel direction relative to the bow (0 following, pi head seas)"),
+    real("sea.spreading", 0.0, "", "cos-2s spreading exponent s; 0 = long-crested, else 1..100"),
+    Variable("sea.seed", "integer", 1, "", "Seed of the wave realisation (phases, frequencies, directions)"),
+    Variable("sea.components", "integer", 200, "", "Number of regular wave components, 10..5000"),
+    real("sea.omega_min", 0.0, "rad/s", "Lowest wave frequency; 0 = 0.5 x peak frequency"),
+    real("sea.omega_max", 0.0, "rad/s", "Highest wave frequency; 0 = 5 x peak frequency"),
+    Variable("vessel.preset", "string", "polar_supply", "", f"Built-in hull: one of {', '.join(PRESETS)}"),
+    Variable("vessel.rao_file", "string", "", "", "RAO table CSV (overrides the preset's RAOs when not empty)"),
+    real("vessel.speed", 0.0, "m/s", "Forward speed (encounter frequency), 0..20"),
+    Variable("vessel.mode", "integer", 0, "", "0 RAO response about the COG, 1 rotations independent of translations about vessel.cr"),
+    *vec("vessel.cr", "xyz", 0.0, "m", "Rotation centre for vessel.mode = 1, relative to the COG, body frame"),
+    *vec("imu", "xyz", 0.0, "m", "IMU lever arm relative to the COG, body frame"),
+    real("imu.acc_noise", 7e-4, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, 0..1"),
+    real("imu.gyro_noise", 5e-5, "rad/s/sqrt(Hz)", "Gyro white-noise density, 0..1"),
+    *vec("imu.acc_bias", "xyz", 0.0, "m/s2", "Accelerometer constant bias, body frame"),
+    *vec("imu.gyro_bias", "xyz", 0.0, "rad/s", "Gyro constant bias, body frame"),
+    real("imu.acc_bias_instability", 5e-4, "m/s2", "Accelerometer Gauss-Markov bias standard deviation, 0..1"),
+    real("imu.gyro_bias_instability", 5e-5, "rad/s", "Gyro Gauss-Markov bias standard deviation, 0..1"),
+    real("imu.bias_tau", 50.0, "s", "Gauss-Markov bias correlation time, 0.1..1e6"),
+    Variable("sensors.seed", "integer", 1, "", "Seed of the sensor noise (IMU and GNSS streams)"),
+    real("gnss.rate", 5.0, "Hz", "GNSS fix rate, 0.1..100"),
+    real("gnss.sigma_h", 0.01, "m", "GNSS horizontal noise standard deviation, 0..100"),
+    real("gnss.sigma_v", 0.015, "m", "GNSS vertical noise standard deviation, 0..100"),
+    *[v for i, arm in enumerate(GnssParams().antennas) for v in vec(f"gnss.ant{i + 1}", "xyz", arm, "m", f"GNSS antenna {i + 1} lever arm relative to the COG, body frame")],
+    real("gnss.dropout.start", 0.0, "s", "Start of the GNSS dropout window"),
+    real("gnss.dropout.duration", 0.0, "s", "Length of the GNSS dropout window; 0 = none"),
+    real("gnss.jump.start", 0.0, "s", "Start of the GNSS position-jump window"),
+    real("gnss.jump.duration", 0.0, "s", "Length of the GNSS position-jump window; 0 = none"),
+    *vec("gnss.jump", "ned", 0.0, "m", "GNSS position jump added to every antenna inside the window, NED"),
+    *vec("point", "xyz", (60.0, 0.0, -10.0), "m", "Monitoring point (e.g. bow or crane tip) relative to the COG, body frame"),
+]
+
+_NED = "ned"
+REAL_OUTPUTS: list[Variable] = [
+    *vec("imu.acc", "xyz", 0.0, "m/s2", "Measured specific force at the IMU, body frame"),
+    *vec("imu.gyro", "xyz", 0.0, "rad/s", "Measured angular rate, body frame"),
+    *[v for i in range(ANTENNAS) for v in vec(f"gnss.ant{i + 1}", _NED, 0.0, "m", f"Measured position of GNSS antenna {i + 1}, NED")],
+    *vec("truth.cog", _NED, 0.0, "m", "True COG position, NED (heave positive down)"),
+    *vec("truth.cog_vel", _NED, 0.0, "m/s", "True COG velocity, NED"),
+    *vec("truth.cog_acc", _NED, 0.0, "m/s2", "True COG acceleration, NED"),
+    real("truth.roll", 0.0, "rad", "True roll angle (ZYX Euler)"),
+    real("truth.pitch", 0.0, "rad", "True pitch angle (ZYX Euler)"),
+    real("truth.yaw", 0.0, "rad", "True yaw angle (ZYX Euler) about the mean heading"),
+    *vec("truth.rate", "xyz", 0.0, "rad/s", "True angular rate, body frame"),
+    *vec("truth.ang_acc", "xyz", 0.0, "rad/s2", "True angular acceleration, body frame"),
+    *vec("truth.imu", _NED, 0.0, "m", "True IMU position, NED"),
+    *vec("truth.imu_vel", _NED, 0.0, "m/s", "True IMU velocity, NED"),
+    *vec("truth.imu_acc", _NED, 0.0, "m/s2", "True IMU acceleration, NED"),
+    *vec("truth.imu_f", "xyz", 0.0, "m/s2", "True (error-free) specific force at the IMU, body frame"),
+    *vec("truth.point", _NED, 0.0, "m", "True monitoring-point position, NED"),
+    *vec("truth.point_vel", _NED, 0.0, "m/s", "True monitoring-point velocity, NED"),
+    *vec("truth.point_acc", _NED, 0.0, "m/s2", "True monitoring-point acceleration, NED"),
+    *vec("truth.cr", "xyz", 0.0, "m", "True rotation centre relative to the COG, body frame (COG itself in vessel.mode 0)"),
+    *vec("truth.acc_bias", "xyz", 0.0, "m/s2", "True total accelerometer bias, body frame"),
+    *vec("truth.gyro_bias", "xyz", 0.0, "rad/s", "True total gyro bias, body frame"),
+    real("truth.wave", 0.0, "m", "Wave elevation at the reference point's mean position (positive up)"),
+]
+BOOLEAN_OUTPUTS: list[Variable] = [
+    Variable("gnss.valid", "boolean", False, "", "True when the held GNSS fix is valid (false before the first fix and in dropouts)"),
+    Variable("gnss.new", "boolean", False, "", "True on the step in which a new GNSS fix arrived"),
+    Variable("truth.cr.defined", "boolean", False, "", "True when the motion mode defines a rotation centre (vessel.mode = 1)"),
+]
+#: Index of each real output in the vector returned by :meth:`VesselMotionModel.step`.
+REAL_INDEX = {v.name: i for i, v in enumerate(REAL_OUTPUTS)}
+
+
+@dataclass(frozen=True)
+class VesselMotionParams:
+    """Validated parameters of the VesselMotion model (see :data:`PARAMETERS` for names)."""
+
+    sea: SeaState = field(default_factory=SeaState)
+    preset: str = "polar_supply"
+    rao_file: str = ""
+    speed: float = 0.0
+    mode: int = 0
+    cr: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    imu: ImuParams = field(default_factory=ImuParams)
+    gnss: GnssParams = field(default_factory=GnssParams)
+    point: tuple[float, float, float] = (60.0, 0.0, -10.0)
+    sensor_seed: int = 1
+
+    def __post_init__(self) -> None:
+        check_choice("vessel.preset", self.preset, PRESETS)
+        if not isinstance(self.rao_file, str):
+            raise ParameterError(f"vessel.rao_file must be a path string, got {self.rao_file!r}")
+        check_speed(self.speed)
+        check_int("vessel.mode", self.mode, lo=0, hi=1)
+        check_vector("vessel.cr", self.cr, unit="m")
+        check_vector("point", self.point, unit="m")
+        check_int("sensors.seed", self.sensor_seed, lo=0, hi=2**31 - 1)
+
+    @classmethod
+    def from_flat(cls, values: dict[str, Any]) -> "VesselMotionParams":
+        """Build from FMI-named values (``{"sea.hs": 3.0, …}``); missing names take defaults.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown name (with the closest known names) or an invalid value.
+        """
+        known = {v.name: v for v in PARAMETERS}
+        unknown = [k for k in values if k not in known]
+        if unknown:
+            import difflib
+
+            hints = {k: difflib.get_close_matches(k, known, n=1) for k in unknown}
+            msg = "; ".join(f"{k!r}" + (f" (did you mean {h[0]!r}?)" if h else "") for k, h in hints.items())
+            raise ParameterError(f"unknown VesselMotion parameter(s): {msg}")
+        v = {name: values.get(name, var.default) for name, var in known.items()}
+
+        def xyz(p: str, axes: str = "xyz") -> tuple[float, ...]:
+            return tuple(v[f"{p}.{a}"] for a in axes)
+
+        sea = SeaState(
+            hs=v["sea.hs"], tp=v["sea.tp"], gamma=v["sea.gamma"], spectrum=v["sea.spectrum"],
+            heading=v["sea.heading"], spreading=v["sea.spreading"], seed=v["sea.seed"],
+            n_components=v["sea.components"], omega_min=v["sea.omega_min"], omega_max=v["sea.omega_max"],
+        )
+        imu = ImuParams(
+            lever_arm=xyz("imu"), acc_noise=v["imu.acc_noise"], gyro_noise=v["imu.gyro_noise"],
+            acc_bias=xyz("imu.acc_bias"), gyro_bias=xyz("imu.gyro_bias"),
+            acc_bias_instability=v["imu.acc_bias_instability"], gyro_bias_instability=v["imu.gyro_bias_instability"],
+            bias_tau=v["imu.bias_tau"],
+        )
+        gnss = GnssParams(
+            antennas=tuple(xyz(f"gnss.ant{i + 1}") for i in range(ANTENNAS)), rate=v["gnss.rate"],
+            sigma_h=v["gnss.sigma_h"], sigma_v=v["gnss.sigma_v"],
+            dropout_start=v["gnss.dropout.start"], dropout_duration=v["gnss.dropout.duration"],
+            jump_start=v["gnss.jump.start"], jump_duration=v["gnss.jump.duration"], jump=xyz("gnss.jump", "ned"),
+        )
+        return cls(sea=sea, preset=v["vessel.preset"], rao_file=v["vessel.rao_file"], speed=v["vessel.speed"],
+                   mode=v["vessel.mode"], cr=xyz("vessel.cr"), imu=imu, gnss=gnss, point=xyz("point"),
+                   sensor_seed=v["sensors.seed"])
+
+    def with_sea(self, **changes: Any) -> "VesselMotionParams":
+        """Copy with sea-state fields changed (convenience for sweeps)."""
+        return replace(self, sea=replace(self.sea, **changes))
+
+
+@dataclass(frozen=True)
+class RigidBodyState:
+    """Exact rigid-body state at one time.
+
+    Attributes
+    ----------
+    pos, vel, acc : numpy.ndarray
+        (3,) reference-point position [m], velocity [m/s], acceleration [m/s²], NED.
+    euler : list of float
+        Roll, pitch, yaw [rad].
+    rot : numpy.ndarray
+        (3, 3) R_nb.
+    rate, ang_acc : list of float
+        Body angular rate [rad/s] and angular acceleration [rad/s²].
+    wave : float
+        Wave elevation at the reference point's mean position [m, up].
+    """
+
+    pos: np.ndarray
+    vel: np.ndarray
+    acc: np.ndarray
+    euler: list[float]
+    rot: np.ndarray
+    rate: list[float]
+    ang_acc: list[float]
+    wave: float
+
+    def points(self, arms: np.ndarray) -> np.ndarray:
+        """(k, 9) NED position [m], velocity [m/s] and acceleration [m/s²] of body points.
+
+        Parameters
+        ----------
+        arms : numpy.ndarray
+            (k, 3) lever arms from the reference point, body frame [m].
+        """
+        body = arms @ rigid_point_operator(self.rate, self.ang_acc).T  # (k, 9): l, ω×l, α×l+ω×(ω×l)
+        n = (body.reshape(-1, 3) @ self.rot.T).reshape(-1, 9)
+        n[:, 0:3] += self.pos
+        n[:, 3:6] += self.vel
+        n[:, 6:9] += self.acc
+        return n
+
+
+class VesselMotionModel:
+    """The in-process VesselMotion model: call :meth:`step` with the end time of each step.
+
+    Parameters
+    ----------
+    params : VesselMotionParams
+        Validated parameters; the RAO file (if any) is read here.
+
+    Examples
+    --------
+    >>> m = VesselMotionModel(VesselMotionParams())
+    >>> y = m.step(0.01, 0.01)          # outputs at t = 0.01 s, ordered as REAL_OUTPUTS
+    >>> y[REAL_INDEX["truth.cog.d"]]    # heave of the COG [m, down]  # doctest: +SKIP
+    """
+
+    def __init__(self, params: VesselMotionParams) -> None:
+        self.params = params
+        table: RaoTable = load_rao_csv(params.rao_file) if params.rao_file else preset_raos(params.preset, params.speed)
+        self.waves = realise(params.sea)
+        we = self.waves.encounter_frequency(params.speed)
+        rot_phase = self.waves.extra_phase if params.mode == 1 else self.waves.phase
+        self.series = MotionSeries.build(table, self.waves.omega, self.waves.direction, self.waves.amplitude,
+                                         self.waves.phase, rot_phase, we)
+        self.cr = np.array(params.cr if params.mode == 1 else (0.0, 0.0, 0.0))
+        ant = np.array(params.gnss.antennas, dtype=float)
+        # lever arms from the reference point: COG, IMU, point (per step) and antennas (per fix)
+        self._arms = np.array([[0.0, 0.0, 0.0], params.imu.lever_arm, params.point]) - self.cr
+        self._ant_arms = ant - self.cr
+        self._cr_out = self.cr.copy()
+        self.reset()
+
+    def reset(self) -> None:
+        """Return to t = 0 with freshly seeded sensor noise."""
+        imu_seed, gnss_seed = np.random.SeedSequence(self.params.sensor_seed).spawn(2)
+        self.imu = Imu(self.params.imu, np.random.default_rng(imu_seed))
+        self.gnss = Gnss(self.params.gnss, np.random.default_rng(gnss_seed))
+        self.gnss_new = False
+
+    def rigid_body(self, t: float) -> RigidBodyState:
+        """Exact rigid-body state of the reference point at time ``t`` [s]."""
+        x = self.series.at(t)
+        xl = x.tolist()
+        rot, rate, ang_acc = attitude_kinematics(xl[3:6], xl[9:12], xl[15:18])
+        return RigidBodyState(x[0:3], x[6:9], x[12:15], xl[3:6], rot, rate, ang_acc, xl[18])
+
+    def antenna_positions(self, t: float) -> np.ndarray:
+        """(12,) true antenna positions at ``t`` [s], NED [m], ant1 (n, e, d), ant2, …"""
+        s = self.rigid_body(t)
+        return (s.pos + self._ant_arms @ s.rot.T).ravel()
+
+    def step(self, t: float, dt: float) -> list[float]:
+        """Advance the sensors by ``dt`` [s] and return the real outputs at time ``t`` [s].
+
+        Returns
+        -------
+        list of float
+            Values ordered as :data:`REAL_OUTPUTS`; booleans are in :meth:`boolean_outputs`.
+        """
+        s = self.rigid_body(t)
+        pts = s.points(self._arms)  # rows: COG, IMU, point
+        f_imu = specific_force(s.rot, pts[1, 6:9])
+        meas = self.imu.measure(f_imu, s.rate, dt)
+        k = self.gnss.epoch_due(t)
+        self.gnss_new = k is not None
+        if k is not None:
+            self.gnss.measure(k, self.antenna_positions(k / self.params.gnss.rate))
+        return np.concatenate(
+            (meas, self.gnss.positions, pts[0], s.euler, s.rate, s.ang_acc, pts[1], f_imu, pts[2],
+             self._cr_out, self.imu.bias, (s.wave,))
+        ).tolist()
+
+    def boolean_outputs(self) -> list[bool]:
+        """Values ordered as :data:`BOOLEAN_OUTPUTS`."""
+        return [self.gnss.valid, self.gnss_new, self.params.mode == 1]
+
+    def get_state(self) -> dict:
+        """JSON-serialisable sensor state (the motion itself is a function of time)."""
+        return {"imu": self.imu.get_state(), "gnss": self.gnss.get_state(), "gnss_new": self.gnss_new}
+
+    def set_state(self, state: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.imu.set_state(state["imu"])
+        self.gnss.set_state(state["gnss"])
+        self.gnss_new = bool(state["gnss_new"])

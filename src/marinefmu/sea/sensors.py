@@ -1,0 +1,221 @@
+"""Sensor models: a strapdown IMU at a lever arm and multi-antenna GNSS.
+
+IMU errors per axis: white noise of density N [unit/√Hz] (per-sample standard deviation
+N/√Δt, i.e. band-limited to the sample rate), a constant bias, and a first-order
+Gauss–Markov bias (bias instability) with stationary standard deviation σ_b and correlation
+time τ, discretised exactly: b_{k+1} = φ b_k + σ_b √(1−φ²) w_k, φ = e^{−Δt/τ}. The
+Gauss–Markov state starts from its stationary distribution, so the bias is present at t = 0.
+
+Defaults are a marine MEMS motion sensor: accelerometer 0.0007 m/s²/√Hz, bias 0.0005 m/s²;
+gyro 5e-5 rad/s/√Hz, bias 5e-5 rad/s; bias correlation time 50 s.
+
+GNSS: each antenna reports its NED position at epochs t_k = k / rate with independent white
+noise σ_h (north, east) and σ_v (down), default RTK 1 cm / 1.5 cm; an optional dropout window
+(no fixes, ``valid`` false, last fix held) and an optional position jump (a constant offset
+added to all antennas inside a window, like the DGPS jumps of 10-65 m that paper 000 cites).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, check_range, check_vector
+
+ANTENNAS = 4
+
+
+@dataclass(frozen=True)
+class ImuParams:
+    """IMU placement and error model.
+
+    Parameters
+    ----------
+    lever_arm : tuple of float
+        IMU position relative to the COG, body frame [m].
+    acc_noise, gyro_noise : float
+        White-noise densities [m/s²/√Hz], [rad/s/√Hz]; 0 … 1.
+    acc_bias, gyro_bias : tuple of float
+        Constant biases [m/s²], [rad/s], body frame.
+    acc_bias_instability, gyro_bias_instability : float
+        Stationary standard deviation of the Gauss–Markov bias [m/s²], [rad/s]; 0 … 1.
+    bias_tau : float
+        Gauss–Markov correlation time [s], 0.1 … 1e6.
+    """
+
+    lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    acc_noise: float = 7e-4
+    gyro_noise: float = 5e-5
+    acc_bias: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gyro_bias: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    acc_bias_instability: float = 5e-4
+    gyro_bias_instability: float = 5e-5
+    bias_tau: float = 50.0
+
+    def __post_init__(self) -> None:
+        check_vector("imu.{x,y,z}", self.lever_arm, unit="m")
+        check_range("imu.acc_noise", self.acc_noise, lo=0.0, hi=1.0, unit="m/s2/sqrt(Hz)")
+        check_range("imu.gyro_noise", self.gyro_noise, lo=0.0, hi=1.0, unit="rad/s/sqrt(Hz)")
+        for axis, v in zip("xyz", check_vector("imu.acc_bias", self.acc_bias, unit="m/s2")):
+            check_range(f"imu.acc_bias.{axis}", v, lo=-10.0, hi=10.0, unit="m/s2")
+        for axis, v in zip("xyz", check_vector("imu.gyro_bias", self.gyro_bias, unit="rad/s")):
+            check_range(f"imu.gyro_bias.{axis}", v, lo=-1.0, hi=1.0, unit="rad/s")
+        check_range("imu.acc_bias_instability", self.acc_bias_instability, lo=0.0, hi=1.0, unit="m/s2")
+        check_range("imu.gyro_bias_instability", self.gyro_bias_instability, lo=0.0, hi=1.0, unit="rad/s")
+        check_range("imu.bias_tau", self.bias_tau, lo=0.1, hi=1e6, unit="s")
+
+
+class Imu:
+    """Adds the configured errors to true specific force and angular rate.
+
+    Parameters
+    ----------
+    params : ImuParams
+        Error model.
+    rng : numpy.random.Generator
+        Seeded generator owned by this sensor.
+    """
+
+    def __init__(self, params: ImuParams, rng: np.random.Generator) -> None:
+        self.params = params
+        self._rng = rng
+        self._const = np.concatenate([params.acc_bias, params.gyro_bias])
+        self._sigma_b = np.repeat([params.acc_bias_instability, params.gyro_bias_instability], 3)
+        self._density = np.repeat([params.acc_noise, params.gyro_noise], 3)
+        self.gm_bias = self._sigma_b * self._rng.standard_normal(6)
+
+    @property
+    def bias(self) -> np.ndarray:
+        """(6,) total bias [acc (m/s²), gyro (rad/s)], body frame."""
+        return self._const + self.gm_bias
+
+    def measure(self, f_true: np.ndarray, w_true: list[float], dt: float) -> np.ndarray:
+        """Advance the bias by ``dt`` [s] and return (6,) [f_b (m/s²), ω_b (rad/s)] measured."""
+        phi = math.exp(-dt / self.params.bias_tau)
+        w = self._rng.standard_normal(12)
+        self.gm_bias = phi * self.gm_bias + self._sigma_b * math.sqrt(1.0 - phi * phi) * w[:6]
+        true = np.empty(6)
+        true[:3] = f_true
+        true[3:] = w_true
+        return true + self._const + self.gm_bias + self._density / math.sqrt(dt) * w[6:]
+
+    def get_state(self) -> dict:
+        """JSON-serialisable state (generator and bias)."""
+        return {"rng": self._rng.bit_generator.state, "gm_bias": self.gm_bias.tolist()}
+
+    def set_state(self, state: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self._rng.bit_generator.state = state["rng"]
+        self.gm_bias = np.array(state["gm_bias"], dtype=float)
+
+
+@dataclass(frozen=True)
+class GnssParams:
+    """Multi-antenna GNSS receiver.
+
+    Parameters
+    ----------
+    antennas : tuple
+        Four antenna positions relative to the COG, body frame [m].
+    rate : float
+        Fix rate [Hz], 0.1 … 100.
+    sigma_h, sigma_v : float
+        White-noise standard deviation, horizontal and vertical [m], 0 … 100.
+    dropout_start, dropout_duration : float
+        Dropout window [s]; duration 0 = no dropout.
+    jump_start, jump_duration : float
+        Jump window [s]; duration 0 = no jump.
+    jump : tuple of float
+        Offset added to every antenna inside the jump window, NED [m].
+    """
+
+    antennas: tuple = ((10.0, -4.0, -10.0), (10.0, 4.0, -10.0), (-10.0, -4.0, -10.0), (-10.0, 4.0, -10.0))
+    rate: float = 5.0
+    sigma_h: float = 0.01
+    sigma_v: float = 0.015
+    dropout_start: float = 0.0
+    dropout_duration: float = 0.0
+    jump_start: float = 0.0
+    jump_duration: float = 0.0
+    jump: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if len(self.antennas) != ANTENNAS:
+            raise ParameterError(f"gnss antennas: expected {ANTENNAS} lever arms, got {len(self.antennas)}")
+        arms = np.array([check_vector(f"gnss.ant{i + 1}.{{x,y,z}}", a, unit="m") for i, a in enumerate(self.antennas)])
+        for i in range(ANTENNAS):
+            for j in range(i + 1, ANTENNAS):
+                if np.linalg.norm(arms[i] - arms[j]) < 0.1:
+                    raise ParameterError(f"gnss.ant{i + 1} and gnss.ant{j + 1} are closer than 0.1 m: antennas must be distinct")
+        centred = arms - arms.mean(axis=0)
+        if np.linalg.matrix_rank(centred, tol=0.05) < 2:
+            raise ParameterError("gnss.ant1..4 are collinear: attitude needs antennas spanning a plane")
+        check_range("gnss.rate", self.rate, lo=0.1, hi=100.0, unit="Hz")
+        check_range("gnss.sigma_h", self.sigma_h, lo=0.0, hi=100.0, unit="m")
+        check_range("gnss.sigma_v", self.sigma_v, lo=0.0, hi=100.0, unit="m")
+        check_range("gnss.dropout.start", self.dropout_start, lo=0.0, unit="s")
+        check_range("gnss.dropout.duration", self.dropout_duration, lo=0.0, unit="s")
+        check_range("gnss.jump.start", self.jump_start, lo=0.0, unit="s")
+        check_range("gnss.jump.duration", self.jump_duration, lo=0.0, unit="s")
+        for axis, v in zip("ned", check_vector("gnss.jump", self.jump, unit="m")):
+            check_range(f"gnss.jump.{axis}", v, lo=-1000.0, hi=1000.0, unit="m")
+
+    def in_dropout(self, t: float) -> bool:
+        """True when ``t`` [s] is inside the dropout window."""
+        return self.dropout_duration > 0 and self.dropout_start <= t < self.dropout_start + self.dropout_duration
+
+    def in_jump(self, t: float) -> bool:
+        """True when ``t`` [s] is inside the jump window."""
+        return self.jump_duration > 0 and self.jump_start <= t < self.jump_start + self.jump_duration
+
+
+class Gnss:
+    """Samples antenna positions at the fix epochs and adds noise, dropouts and jumps.
+
+    Parameters
+    ----------
+    params : GnssParams
+        Receiver model.
+    rng : numpy.random.Generator
+        Seeded generator owned by this sensor.
+    """
+
+    def __init__(self, params: GnssParams, rng: np.random.Generator) -> None:
+        self.params = params
+        self._rng = rng
+        self._sigma = np.tile([params.sigma_h, params.sigma_h, params.sigma_v], ANTENNAS)
+        self.last_epoch = -1
+        self.positions = np.zeros(3 * ANTENNAS)
+        self.valid = False
+
+    def epoch_due(self, t: float) -> int | None:
+        """Index k of the newest epoch t_k = k/rate ≤ t if not yet reported, else None."""
+        k = math.floor(t * self.params.rate + 1e-9)
+        return k if k > self.last_epoch else None
+
+    def measure(self, k: int, truth: np.ndarray) -> None:
+        """Record epoch ``k`` from (12,) true antenna positions (NED [m], ant1 n,e,d, ant2 …)."""
+        self.last_epoch = k
+        t = k / self.params.rate
+        noise = self._sigma * self._rng.standard_normal(3 * ANTENNAS)
+        if self.params.in_dropout(t):
+            self.valid = False
+            return
+        meas = truth + noise
+        if self.params.in_jump(t):
+            meas = meas + np.tile(self.params.jump, ANTENNAS)
+        self.positions = meas
+        self.valid = True
+
+    def get_state(self) -> dict:
+        """JSON-serialisable state."""
+        return {"rng": self._rng.bit_generator.state, "last_epoch": self.last_epoch,
+                "positions": self.positions.tolist(), "valid": self.valid}
+
+    def set_state(self, state: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self._rng.bit_generator.state = state["rng"]
+        self.last_epoch = int(state["last_epoch"])
+        self.positions = np.array(state["positions"], dtype=float)
+        self.valid = bool(state["valid"])
