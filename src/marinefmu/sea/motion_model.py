@@ -285,14 +285,25 @@ class VesselMotionModel:
         list of float
             Values ordered as :data:`REAL_OUTPUTS`; booleans are in :meth:`boolean_outputs`.
         """
+        return self._outputs(t, dt)
+
+    def peek(self, t: float) -> list[float]:
+        """Outputs at ``t`` [s] without advancing the sensors (IMU = truth + current bias, no
+        white noise; GNSS unchanged). Used for the values an FMU shows after initialisation."""
+        return self._outputs(t, None)
+
+    def _outputs(self, t: float, dt: float | None) -> list[float]:
         s = self.rigid_body(t)
         pts = s.points(self._arms)  # rows: COG, IMU, point
         f_imu = specific_force(s.rot, pts[1, 6:9])
-        meas = self.imu.measure(f_imu, s.rate, dt)
-        k = self.gnss.epoch_due(t)
-        self.gnss_new = k is not None
-        if k is not None:
-            self.gnss.measure(k, self.antenna_positions(k / self.params.gnss.rate))
+        if dt is None:
+            meas = np.concatenate((f_imu, s.rate)) + self.imu.bias
+        else:
+            meas = self.imu.measure(f_imu, s.rate, dt)
+            k = self.gnss.epoch_due(t)
+            self.gnss_new = k is not None
+            if k is not None:
+                self.gnss.measure(k, self.antenna_positions(k / self.params.gnss.rate))
         return np.concatenate(
             (meas, self.gnss.positions, pts[0], s.euler, s.rate, s.ang_acc, pts[1], f_imu, pts[2],
              self._cr_out, self.imu.bias, (s.wave,))

@@ -1,0 +1,15 @@
+#!/usr/bin/env python3
+"""Build every models/*.py into fmus/*.fmu, add units, and validate (see marinefmu.cosim.build)."""
+import argparse
+import sys
+
+from marinefmu.cosim.build import BuildError, build_all
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--force", action="store_true", help="rebuild even if nothing changed")
+    args = parser.parse_args()
+    try:
+        build_all(force=args.force)
+    except BuildError as exc:
+        sys.exit(f"build_fmus.py: {exc}")

@@ -1,0 +1,40 @@
+"""VesselMotion FMU: waves → 6-DOF motion → IMU and GNSS signals, with exact truth.
+
+A thin adapter: all numerics are in ``marinefmu.sea.motion_model``.
+"""
+from pythonfmu import Fmi2Slave
+
+from marinefmu import __version__
+from marinefmu.cosim.slave import SlaveIO
+from marinefmu.sea.motion_model import (
+    BOOLEAN_OUTPUTS, PARAMETERS, REAL_OUTPUTS, VesselMotionModel, VesselMotionParams,
+)
+
+
+class VesselMotion(Fmi2Slave):
+    author = "marinefmu developers"
+    description = "Vessel in irregular waves: 6-DOF RAO motion, IMU and 4-antenna GNSS with errors, exact truth"
+    version = __version__
+    license = "MIT"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.io = SlaveIO(self, PARAMETERS, REAL_OUTPUTS, BOOLEAN_OUTPUTS)
+        self.model = None
+
+    def setup_experiment(self, start_time, stop_time, tolerance):
+        self.io.start_time = start_time
+
+    def exit_initialization_mode(self):
+        self.model = self.io.build(lambda values: VesselMotionModel(VesselMotionParams.from_flat(values)))
+        self.io.set_outputs(self.model.peek(self.io.start_time), self.model.boolean_outputs())
+
+    def do_step(self, current_time, step_size):
+        self.io.set_outputs(self.model.step(current_time + step_size, step_size), self.model.boolean_outputs())
+        return True
+
+    def _get_fmu_state(self):
+        return self.io.get_state(self.model)
+
+    def _set_fmu_state(self, state):
+        self.io.set_state(self.model, state)

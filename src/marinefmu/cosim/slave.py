@@ -1,0 +1,120 @@
+"""Plumbing shared by the pythonfmu slaves in ``models/``.
+
+pythonfmu's C++ loader finds the slave class by the literal text ``class X(Fmi2Slave):`` in
+the script, so the scripts cannot inherit from a common base; they compose a :class:`SlaveIO`
+instead. It registers a model's variable tables (``marinefmu.interface.Variable``) with
+getters and setters on plain dicts and lists, turns a refused parameter into an FMU log
+message that names it, and saves/restores the model's internal state together with the
+registered variables (pythonfmu's default state only covers registered variables).
+"""
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Variability, Integer, Real, String
+from pythonfmu.enums import Fmi2Status
+from pythonfmu.fmi2slave import Fmi2Slave
+
+from ..errors import MarineFmuError
+from ..interface import Variable
+
+M = TypeVar("M")
+_FMI_TYPES = {"real": Real, "integer": Integer, "boolean": Boolean, "string": String}
+_CAST: dict[str, Callable[[Any], Any]] = {"real": float, "integer": int, "boolean": bool, "string": str}
+
+
+def _describe(var: Variable) -> str:
+    return f"{var.description} [{var.unit}]" if var.unit else var.description
+
+
+class SlaveIO:
+    """Variables of one slave instance.
+
+    Parameters
+    ----------
+    slave : Fmi2Slave
+        The instance to register variables on.
+    parameters : sequence of Variable
+        Parameters (variability ``fixed``: set before initialisation).
+    outputs : sequence of Variable
+        Real outputs, in the order of the model's output list.
+    boolean_outputs : sequence of Variable
+        Boolean outputs, in the order of the model's boolean list.
+    inputs : sequence of Variable
+        Inputs (real, integer or boolean), stored in :attr:`inputs` by name.
+    """
+
+    def __init__(self, slave: Fmi2Slave, parameters: Sequence[Variable], outputs: Sequence[Variable],
+                 boolean_outputs: Sequence[Variable] = (), inputs: Sequence[Variable] = ()) -> None:
+        self.slave = slave
+        self.params: dict[str, Any] = {v.name: v.default for v in parameters}
+        self.inputs: dict[str, Any] = {v.name: v.default for v in inputs}
+        self.real_out: list[float] = [float(v.default) for v in outputs]
+        self.bool_out: list[bool] = [bool(v.default) for v in boolean_outputs]
+        self.start_time = 0.0
+        #: FMI unit of every registered variable (read by the build to write UnitDefinitions).
+        self.units: dict[str, str] = {v.name: v.unit for v in (*parameters, *inputs, *outputs, *boolean_outputs)}
+        for v in parameters:
+            self._register(v, Fmi2Causality.parameter, Fmi2Variability.fixed, self.params)
+        for v in inputs:
+            self._register(v, Fmi2Causality.input, Fmi2Variability.continuous if v.kind == "real" else Fmi2Variability.discrete, self.inputs)
+        for i, v in enumerate(outputs):
+            slave.register_variable(Real(v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+                                         description=_describe(v), getter=self._item_getter(self.real_out, i)), nested=False)
+        for i, v in enumerate(boolean_outputs):
+            slave.register_variable(Boolean(v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
+                                            description=_describe(v), getter=self._item_getter(self.bool_out, i)), nested=False)
+
+    def _register(self, v: Variable, causality: Fmi2Causality, variability: Fmi2Variability, store: dict) -> None:
+        cast = _CAST[v.kind]
+
+        def setter(value: Any, name: str = v.name) -> None:
+            store[name] = cast(value)
+
+        self.slave.register_variable(
+            _FMI_TYPES[v.kind](v.name, causality=causality, variability=variability, description=_describe(v),
+                               getter=lambda name=v.name: store[name], setter=setter),
+            nested=False,
+        )
+
+    @staticmethod
+    def _item_getter(values: list, i: int) -> Callable[[], Any]:
+        return lambda: values[i]
+
+    def build(self, factory: Callable[[dict[str, Any]], M]) -> M:
+        """Build the model from the parameter values, logging a refusal before re-raising it.
+
+        A :class:`~marinefmu.errors.MarineFmuError` (e.g. ``sea.hs = -1 is out of range``) is
+        logged with status error, so the importing tool shows which parameter was refused; the
+        exception then makes pythonfmu fail the initialisation.
+        """
+        try:
+            return factory(dict(self.params))
+        except MarineFmuError as exc:
+            self.slave.log(f"{self.slave.instance_name}: invalid parameter: {exc}", Fmi2Status.error)
+            raise
+
+    def set_outputs(self, reals: list[float], booleans: list[bool] | None = None) -> None:
+        """Replace the output values in place (the getters hold references to these lists)."""
+        self.real_out[:] = reals
+        if booleans is not None:
+            self.bool_out[:] = booleans
+
+    def get_state(self, model: Any) -> dict:
+        """FMU state: parameters, inputs, outputs and the model's own state (JSON-serialisable)."""
+        return {
+            "params": dict(self.params), "inputs": dict(self.inputs), "real_out": list(self.real_out),
+            "bool_out": list(self.bool_out), "start_time": self.start_time,
+            "model": copy.deepcopy(model.get_state()) if model is not None else None,
+        }
+
+    def set_state(self, model: Any, state: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.params.update(state["params"])
+        self.inputs.update(state["inputs"])
+        self.set_outputs(state["real_out"], state["bool_out"])
+        self.start_time = state["start_time"]
+        if model is not None and state["model"] is not None:
+            model.set_state(copy.deepcopy(state["model"]))
