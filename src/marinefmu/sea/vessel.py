@@ -158,6 +158,23 @@ def _moment_factor(x: np.ndarray) -> np.ndarray:
     return np.where(small, 1.0 - x**2 / 10.0, out)
 
 
+def _tapered_factors(kx: np.ndarray, length: float, n: int = 401) -> tuple[np.ndarray, np.ndarray]:
+    """Force and moment factors of a tapered waterplane w(x) = cos²(πx/L), |x| ≤ L/2.
+
+    F(k_x) = ∫w cos(k_x x) dx / ∫w and M(k_x) = ∫x w sin(k_x x) dx / (k_x ∫x² w dx), both → 1
+    for long waves. A ship's waterplane narrows towards bow and stern, so unlike a box (sinc)
+    the excitation has no deep zeros when the wavelength is close to the ship length.
+    """
+    x = np.linspace(-length / 2, length / 2, n)
+    w = np.cos(np.pi * x / length) ** 2
+    arg = kx[..., None] * x
+    force = np.trapezoid(w * np.cos(arg), x, axis=-1) / np.trapezoid(w, x)
+    i2 = np.trapezoid(x**2 * w, x)
+    safe = np.where(np.abs(kx) < 1e-9, 1.0, kx)
+    moment = np.where(np.abs(kx) < 1e-9, 1.0, np.trapezoid(x * w * np.sin(arg), x, axis=-1) / (safe * i2))
+    return force, moment
+
+
 def _oscillator(omega_e: np.ndarray, period: float, zeta: float) -> np.ndarray:
     """Dynamic amplification H = 1 / (1 − r² + 2iζr), r = ω_e/ω_n."""
     r = np.abs(omega_e) * period / (2 * math.pi)
@@ -169,9 +186,10 @@ def parametric_raos(hull: HullParticulars, name: str, speed: float = 0.0) -> Rao
 
     Each DOF is its long-wave limit (the hull follows the surface: heave = −η, pitch =
     ∂η/∂x, roll = −∂η/∂y, surge/sway = horizontal particle motion), times an attenuation for
-    waves short compared with the hull (strip force/moment factors over the length and beam,
-    and the pressure decay e^{−kT} over the draft), times a one-DOF dynamic amplification at
-    the encounter frequency for heave, roll and pitch.
+    waves short compared with the hull (force/moment factors of a tapered waterplane along
+    the length, :func:`_tapered_factors`, and of a uniform strip across the beam, and the
+    pressure decay e^{−kT} over the draft), times a one-DOF dynamic amplification at the
+    encounter frequency for heave, roll and pitch.
 
     Parameters
     ----------
@@ -188,15 +206,16 @@ def parametric_raos(hull: HullParticulars, name: str, speed: float = 0.0) -> Rao
     k = w**2 / G
     we = w - k * speed * np.cos(b)
     cb, sb = np.cos(b), np.sin(b)
-    xl, xb = k * hull.length * cb / 2.0, k * hull.beam * sb / 2.0
+    xb = k * hull.beam * sb / 2.0
+    fl, ml = _tapered_factors(k * cb, hull.length)
     depth = np.exp(-k * hull.draft)
     rao = np.empty((6,) + w.shape, dtype=complex)
-    rao[0] = -1j * cb * _sinc(xl) * depth
+    rao[0] = -1j * cb * fl * depth
     rao[1] = -1j * sb * _sinc(xb) * depth
-    rao[2] = -1.0 * _sinc(xl) * _sinc(xb) * depth * _oscillator(we, hull.t_heave, hull.zeta_heave)
-    rao[3] = 1j * k * sb * _moment_factor(xb) * _sinc(xl) * depth * _oscillator(we, hull.t_roll, hull.zeta_roll)
-    rao[4] = -1j * k * cb * _moment_factor(xl) * _sinc(xb) * depth * _oscillator(we, hull.t_pitch, hull.zeta_pitch)
-    rao[5] = -0.5 * k * sb * cb * _moment_factor(xl) * depth
+    rao[2] = -1.0 * fl * _sinc(xb) * depth * _oscillator(we, hull.t_heave, hull.zeta_heave)
+    rao[3] = 1j * k * sb * _moment_factor(xb) * fl * depth * _oscillator(we, hull.t_roll, hull.zeta_roll)
+    rao[4] = -1j * k * cb * ml * _sinc(xb) * depth * _oscillator(we, hull.t_pitch, hull.zeta_pitch)
+    rao[5] = -0.5 * k * sb * cb * ml * depth
     return RaoTable(omega=omega, heading=heading, rao=rao, name=name)
 
 

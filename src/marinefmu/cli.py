@@ -1,0 +1,106 @@
+"""The ``marinefmu`` command line: build FMUs, simulate scenarios, benchmark.
+
+Examples
+--------
+::
+
+    marinefmu build
+    marinefmu simulate default --duration 120 --out results/default
+    marinefmu simulate my_scenario.toml
+    marinefmu bench
+"""
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import time
+from pathlib import Path
+
+from .errors import MarineFmuError
+
+
+def _cmd_build(args: argparse.Namespace) -> int:
+    from .cosim.build import build_all
+
+    build_all(force=args.force)
+    return 0
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .cosim.ssp import write_ssd
+    from .cosim.system import SystemRunner, save_csv
+    from .report import plot_vessel, vessel_components, vessel_summary
+    from .scenarios import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    fmu_dir = Path(args.fmus) if args.fmus else None
+    if fmu_dir is None:
+        from .cosim.build import build_all, repo_root
+
+        build_all(verbose=False)
+        fmu_dir = repo_root() / "fmus"
+    duration = scenario.duration if args.duration is None else args.duration
+    if not duration > 0:
+        raise MarineFmuError(f"--duration = {duration} is out of range: must be > 0 [s]")
+    out = Path(args.out or f"results/{scenario.name}")
+    out.mkdir(parents=True, exist_ok=True)
+    ssd = write_ssd(scenario.system, out / "SystemStructure.ssd")
+    print(f"scenario {scenario.name}: {scenario.description}")
+    print(f"  {len(scenario.system.components)} component(s), {duration:g} s at {scenario.step:g} s; system file {ssd}")
+    runner = SystemRunner(scenario.system, fmu_dir)
+    t0 = time.perf_counter()
+    result = runner.run(scenario.system.start_time + duration, record=scenario.record,
+                        progress=False if args.no_progress else None)
+    wall = time.perf_counter() - t0
+    csv = save_csv(result, out / "results.csv")
+    print(f"  simulated in {wall:.1f} s ({(result.size - 1) / wall:,.0f} base steps/s); results {csv}")
+    for comp in vessel_components(result):
+        for p in plot_vessel(result, comp, out):
+            print(f"  plot {p}")
+        print(f"  summary of {comp}:")
+        for k, v in vessel_summary(result, comp).items():
+            print(f"    {k:28s} {v:.6g}")
+    problems = [m for m in runner.messages if m.status in ("WARNING", "ERROR", "FATAL")]
+    for m in problems:
+        print(f"  FMU {m.status.lower()}: {m.instance}: {m.text}")
+    return 0
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from .bench import run_benchmarks
+
+    run_benchmarks(Path(args.out), steps=args.steps)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``marinefmu`` console script."""
+    parser = argparse.ArgumentParser(prog="marinefmu", description="Marine motion estimation FMUs: build, simulate, benchmark.")
+    parser.add_argument("-v", "--verbose", action="store_true", help="show FMU debug messages")
+    sub = parser.add_subparsers(dest="command", required=True)
+    b = sub.add_parser("build", help="build models/*.py into fmus/*.fmu and validate them")
+    b.add_argument("--force", action="store_true", help="rebuild even if nothing changed")
+    b.set_defaults(func=_cmd_build)
+    s = sub.add_parser("simulate", help="run a scenario (TOML file or built-in name) and write CSV and PNG plots")
+    s.add_argument("scenario", help="scenario TOML file, or a built-in name such as 'default'")
+    s.add_argument("--duration", type=float, help="simulated time [s] (default: the scenario's)")
+    s.add_argument("--out", help="output folder (default results/<scenario name>)")
+    s.add_argument("--fmus", help="folder holding the FMUs (default: build into the checkout's fmus/)")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.set_defaults(func=_cmd_simulate)
+    k = sub.add_parser("bench", help="measure speed (writes JSON and prints a table)")
+    k.add_argument("--out", default="bench", help="output folder for bench.json (default bench/)")
+    k.add_argument("--steps", type=int, default=60000, help="FMU steps per measurement (default 60000)")
+    k.set_defaults(func=_cmd_bench)
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return args.func(args)
+    except MarineFmuError as exc:
+        print(f"marinefmu: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
