@@ -1,0 +1,130 @@
+"""``marinefmu bench``: speed of the VesselMotion FMU through FMPy (JSON + printed table).
+
+Measured, never asserted in tests (the machine is shared and noisy). Each figure is the best
+of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components:
+
+- ``fmpy_dostep``: ``fmi2DoStep`` only (the FMU computing motion and sensors);
+- ``fmpy_dostep_sensors``: plus reading the 18 sensor outputs and 2 GNSS flags each step
+  (what an estimator connected to it needs);
+- ``fmpy_dostep_all``: plus reading all outputs each step;
+- ``in_process``: ``VesselMotionModel.step`` without FMI;
+- ``system_runner``: the FMPy system master recording every output.
+"""
+from __future__ import annotations
+
+import datetime
+import json
+import os
+import platform
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+from .sea.motion_model import BOOLEAN_OUTPUTS, REAL_OUTPUTS, VesselMotionModel, VesselMotionParams
+
+DT = 0.01
+SENSORS = [v.name for v in REAL_OUTPUTS if v.name.startswith(("imu.", "gnss."))]
+
+
+def machine() -> dict[str, str | int]:
+    """Where the benchmark ran."""
+    cpu = platform.processor() or "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count() or 0, "python": platform.python_version(), "os": platform.platform()}
+
+
+def _best(fn, repeats: int = 3) -> float:
+    return min(fn() for _ in range(repeats))
+
+
+def _fmpy_rate(fmu_path: Path, steps: int, read: list[str] | None, read_bool: bool) -> float:
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(fmu_path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    tmp = Path(tempfile.mkdtemp(prefix="marinefmu_bench_"))
+    try:
+        unzip = extract(str(fmu_path), unzipdir=str(tmp))
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.setInteger([vr["sea.components"]], [200])
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        reals = [vr[n] for n in read] if read else None
+        bools = [vr[v.name] for v in BOOLEAN_OUTPUTS[:2]]
+        do_step, get_real, get_bool = fmu.doStep, fmu.getReal, fmu.getBoolean
+        t0 = time.perf_counter()
+        for k in range(steps):
+            do_step(k * DT, DT)
+            if reals:
+                get_real(reals)
+            if read_bool:
+                get_bool(bools)
+        wall = time.perf_counter() - t0
+        fmu.terminate()
+        fmu.freeInstance()
+        return steps / wall
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _in_process_rate(steps: int) -> float:
+    m = VesselMotionModel(VesselMotionParams())
+    t0 = time.perf_counter()
+    for k in range(1, steps + 1):
+        m.step(k * DT, DT)
+    return steps / (time.perf_counter() - t0)
+
+
+def _runner_rate(fmu_dir: Path, steps: int) -> float:
+    from .cosim.ssp import Component, SystemDescription
+    from .cosim.system import SystemRunner
+
+    system = SystemDescription("bench", (Component("vessel", "VesselMotion.fmu", {"sea.components": 200}),), (), DT, steps * DT)
+    t0 = time.perf_counter()
+    SystemRunner(system, fmu_dir).run(progress=False)
+    return steps / (time.perf_counter() - t0)
+
+
+def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None) -> dict:
+    """Run every measurement, write ``out_dir/bench.json`` and print a table; return the data."""
+    from .cosim.build import build_all, repo_root
+
+    if fmu_dir is None:
+        build_all(verbose=False)
+        fmu_dir = repo_root() / "fmus"
+    fmu = fmu_dir / "VesselMotion.fmu"
+    all_outputs = [v.name for v in REAL_OUTPUTS]
+    rates = {
+        "fmpy_dostep": _best(lambda: _fmpy_rate(fmu, steps, None, False)),
+        "fmpy_dostep_sensors": _best(lambda: _fmpy_rate(fmu, steps, SENSORS, True)),
+        "fmpy_dostep_all": _best(lambda: _fmpy_rate(fmu, steps, all_outputs, True)),
+        "in_process": _best(lambda: _in_process_rate(steps)),
+        "system_runner": _best(lambda: _runner_rate(fmu_dir, steps)),
+    }
+    three_hours = 3 * 3600 / DT
+    data = {
+        "date": datetime.date.today().isoformat(),
+        "machine": machine(),
+        "setup": {"model": "VesselMotion", "wave_components": 200, "step_s": DT, "steps": steps, "repeats": 3},
+        "steps_per_second": rates,
+        "three_hour_100hz_record_s": {k: three_hours / v for k, v in rates.items()},
+        "goal": {"fmpy_steps_per_second": 20000, "met_by_fmpy_dostep": rates["fmpy_dostep"] >= 20000},
+    }
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "bench.json").write_text(json.dumps(data, indent=2))
+    print(f"VesselMotion, 200 components, dt = {DT} s, best of 3 × {steps} steps ({data['date']}, {data['machine']['cpu']}, {data['machine']['cores']} cores)")
+    print(f"{'measurement':24s} {'steps/s':>10s} {'3 h @ 100 Hz':>14s}")
+    for k, v in rates.items():
+        print(f"{k:24s} {v:10,.0f} {three_hours / v:12.1f} s")
+    print(f"wrote {out_dir / 'bench.json'}")
+    return data
