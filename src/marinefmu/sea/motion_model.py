@@ -20,8 +20,10 @@ Motion modes (``vessel.mode``):
 
 0. RAO response: all six DOFs from one wave realisation, referenced to the COG.
 1. Independent rotations: translations of the rotation centre ``vessel.cr`` and the rotations
-   are driven by independent random phase sets (same spectra), so the CR's acceleration is
-   statistically independent of the rotations: the known truth for paper 002's estimator.
+   are driven by two independent realisations of the same sea state (own frequencies and
+   phases), so the CR's acceleration is uncorrelated with the rotations, also within one
+   record (shared frequencies with independent phases would leave a sample correlation of
+   ~1/√N_eff that never averages out): the known truth for paper 002's estimator.
 """
 from __future__ import annotations
 
@@ -246,10 +248,8 @@ class VesselMotionModel:
         self.params = params
         table: RaoTable = load_rao_csv(params.rao_file) if params.rao_file else preset_raos(params.preset, params.speed)
         self.waves = realise(params.sea)
-        we = self.waves.encounter_frequency(params.speed)
-        rot_phase = self.waves.extra_phase if params.mode == 1 else self.waves.phase
-        self.series = MotionSeries.build(table, self.waves.omega, self.waves.direction, self.waves.amplitude,
-                                         self.waves.phase, rot_phase, we)
+        rot_waves = realise(params.sea, stream=1) if params.mode == 1 else None
+        self.series = MotionSeries.build(table, self.waves, params.speed, rot_waves)
         self.cr = np.array(params.cr if params.mode == 1 else (0.0, 0.0, 0.0))
         ant = np.array(params.gnss.antennas, dtype=float)
         # lever arms from the reference point: COG, IMU, point (per step) and antennas (per fix)

@@ -20,10 +20,15 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..errors import RaoFileError, check_choice, check_range
 from ..frames import G
+
+if TYPE_CHECKING:
+    from .waves import WaveField
 
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 CSV_COLUMNS = ("omega", "heading") + tuple(f"{d}_{p}" for d in DOFS for p in ("amp", "phase"))
@@ -313,19 +318,35 @@ class MotionSeries:
     omega_e: np.ndarray
 
     @classmethod
-    def build(cls, table: RaoTable, omega: np.ndarray, direction: np.ndarray, amplitude: np.ndarray,
-              phase_translation: np.ndarray, phase_rotation: np.ndarray, omega_e: np.ndarray) -> "MotionSeries":
+    def build(cls, table: RaoTable, trans: "WaveField", speed: float, rot: "WaveField | None" = None) -> "MotionSeries":
         """Combine RAOs and wave components into the coefficient matrix.
 
-        ``phase_rotation`` differs from ``phase_translation`` only in the independent-rotation
-        mode, where rotations are driven by an independent phase set.
+        Parameters
+        ----------
+        table : RaoTable
+            Vessel RAOs.
+        trans : WaveField
+            Realisation driving the translations (and the rotations when ``rot`` is None).
+        speed : float
+            Forward speed [m/s] (encounter frequencies).
+        rot : WaveField, optional
+            An independent realisation driving the rotations (independent-rotation mode): the
+            matrix then has 2N columns, translations on the first N, rotations on the last N.
         """
-        r = table.interpolate(omega, direction)  # (6, N)
-        phases = np.vstack([np.repeat(phase_translation[None], 3, 0), np.repeat(phase_rotation[None], 3, 0)])
-        c = r * amplitude * np.exp(1j * phases)
-        wave = amplitude * np.exp(1j * phase_translation)
-        coef = np.vstack([c, 1j * omega_e * c, -(omega_e**2) * c, wave[None]])
-        return cls(coef=coef, omega_e=np.asarray(omega_e, dtype=float))
+        def coefficients(field: "WaveField") -> tuple[np.ndarray, np.ndarray]:
+            c = table.interpolate(field.omega, field.direction) * field.amplitude * np.exp(1j * field.phase)
+            return c, field.encounter_frequency(speed)
+
+        c, we = coefficients(trans)
+        wave = trans.amplitude * np.exp(1j * trans.phase)
+        if rot is not None:
+            cr, wr = coefficients(rot)
+            zeros = np.zeros((3, c.shape[1]))
+            c = np.vstack([np.hstack([c[:3], zeros]), np.hstack([zeros, cr[3:]])])
+            we = np.concatenate([we, wr])
+            wave = np.concatenate([wave, np.zeros(cr.shape[1])])
+        coef = np.vstack([c, 1j * we * c, -(we**2) * c, wave[None]])
+        return cls(coef=coef, omega_e=np.asarray(we, dtype=float))
 
     def at(self, t: float) -> np.ndarray:
         """(19,) [x(6), ẋ(6), ẍ(6), η] at time ``t`` [s]."""

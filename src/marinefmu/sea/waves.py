@@ -20,7 +20,7 @@ from the vessel's bow (body x) towards starboard (body y) [rad]: 0 following sea
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import integrate, special
@@ -199,7 +199,6 @@ class WaveField:
     phase: np.ndarray
     direction: np.ndarray
     d_omega: float
-    extra_phase: np.ndarray = field(repr=False)
 
     @property
     def wavenumber(self) -> np.ndarray:
@@ -226,15 +225,16 @@ class WaveField:
         return out
 
 
-def realise(sea: SeaState) -> WaveField:
+def realise(sea: SeaState, stream: int = 0) -> WaveField:
     """Draw the seeded realisation of ``sea``.
 
     The seed feeds a :class:`numpy.random.SeedSequence` spawned into independent streams for
-    frequency jitter, phases, directions and a second phase set (used by the vessel's
-    independent-rotation mode), so changing one never shifts the others.
+    frequency jitter, phases and directions, so changing one never shifts the others.
+    ``stream`` selects another, statistically independent realisation of the same sea state
+    (the vessel's independent-rotation mode drives the rotations with ``stream=1``).
     """
-    jitter_rng, phase_rng, dir_rng, extra_rng = (
-        np.random.default_rng(s) for s in np.random.SeedSequence(sea.seed).spawn(4)
+    jitter_rng, phase_rng, dir_rng = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(sea.seed).spawn(3 * (stream + 1))[3 * stream:]
     )
     lo, hi = sea.omega_range
     n = sea.n_components
@@ -249,5 +249,4 @@ def realise(sea: SeaState) -> WaveField:
         direction = sea.heading + np.interp(dir_rng.uniform(0.0, 1.0, n), cdf, grid)
     else:
         direction = np.full(n, float(sea.heading))
-    extra = extra_rng.uniform(0.0, 2.0 * math.pi, n)
-    return WaveField(omega=omega, amplitude=amplitude, phase=phase, direction=direction, d_omega=dw, extra_phase=extra)
+    return WaveField(omega=omega, amplitude=amplitude, phase=phase, direction=direction, d_omega=dw)
