@@ -1,6 +1,7 @@
 """VesselMotion FMU: waves → 6-DOF motion → IMU and GNSS signals, with exact truth.
 
-A thin adapter: all numerics are in ``marinefmu.sea.motion_model``.
+A thin adapter: all numerics are in ``marinefmu.sea.motion_model``. A refused parameter is
+logged at initialisation and the FMU then discards every step (see ``marinefmu.cosim.slave``).
 """
 from pythonfmu import Fmi2Slave
 
@@ -27,11 +28,12 @@ class VesselMotion(Fmi2Slave):
 
     def exit_initialization_mode(self):
         self.model = self.io.build(lambda values: VesselMotionModel(VesselMotionParams.from_flat(values)))
-        self.io.set_outputs(self.model.peek(self.io.start_time), self.model.boolean_outputs())
+        if self.model is not None:
+            self.io.set_outputs(self.model.peek(self.io.start_time), self.model.boolean_outputs())
 
     def do_step(self, current_time, step_size):
-        self.io.set_outputs(self.model.step(current_time + step_size, step_size), self.model.boolean_outputs())
-        return True
+        return self.io.step(lambda: self.io.set_outputs(self.model.step(current_time + step_size, step_size),
+                                                        self.model.boolean_outputs()))
 
     def _get_fmu_state(self):
         return self.io.get_state(self.model)

@@ -3,9 +3,18 @@
 pythonfmu's C++ loader finds the slave class by the literal text ``class X(Fmi2Slave):`` in
 the script, so the scripts cannot inherit from a common base; they compose a :class:`SlaveIO`
 instead. It registers a model's variable tables (``marinefmu.interface.Variable``) with
-getters and setters on plain dicts and lists, turns a refused parameter into an FMU log
-message that names it, and saves/restores the model's internal state together with the
-registered variables (pythonfmu's default state only covers registered variables).
+getters and setters on plain dicts and lists, and saves/restores the model's internal state
+together with the registered variables (pythonfmu's default state only covers registered
+variables).
+
+**Slaves never raise.** pythonfmu turns a Python exception into fmi2Fatal, and in 0.7.0 its
+handler releases the slave class once more than it should (``handle_py_exception`` and the
+instance destructor both call ``cleanPyObject``): after about three exceptions in one
+process the interpreter crashes. So a refused parameter is logged with status error (naming
+the parameter and its range) at initialisation, the model is not built, and every
+``doStep`` logs the refusal again and returns ``False`` (fmi2Discard); an unexpected error in
+a step is handled the same way. :class:`~marinefmu.cosim.system.SystemRunner` treats an
+error logged during initialisation as a refusal and raises with that message.
 """
 from __future__ import annotations
 
@@ -54,6 +63,8 @@ class SlaveIO:
         self.real_out: list[float] = [float(v.default) for v in outputs]
         self.bool_out: list[bool] = [bool(v.default) for v in boolean_outputs]
         self.start_time = 0.0
+        #: Why the slave cannot step (refused parameter or failed step), else None.
+        self.error: str | None = None
         #: FMI unit of every registered variable (read by the build to write UnitDefinitions).
         self.units: dict[str, str] = {v.name: v.unit for v in (*parameters, *inputs, *outputs, *boolean_outputs)}
         for v in parameters:
@@ -83,18 +94,34 @@ class SlaveIO:
     def _item_getter(values: list, i: int) -> Callable[[], Any]:
         return lambda: values[i]
 
-    def build(self, factory: Callable[[dict[str, Any]], M]) -> M:
-        """Build the model from the parameter values, logging a refusal before re-raising it.
+    def build(self, factory: Callable[[dict[str, Any]], M]) -> M | None:
+        """Build the model from the parameter values; on refusal log it and return None.
 
-        A :class:`~marinefmu.errors.MarineFmuError` (e.g. ``sea.hs = -1 is out of range``) is
-        logged with status error, so the importing tool shows which parameter was refused; the
-        exception then makes pythonfmu fail the initialisation.
+        A :class:`~marinefmu.errors.MarineFmuError` (e.g. ``sea.hs = -1.0 is out of range``) is
+        logged with status error so the importing tool shows which parameter was refused;
+        :attr:`error` keeps the message and :meth:`step` then refuses to step.
         """
+        self.error = None
         try:
             return factory(dict(self.params))
         except MarineFmuError as exc:
-            self.slave.log(f"{self.slave.instance_name}: invalid parameter: {exc}", Fmi2Status.error)
-            raise
+            self.error = f"invalid parameter: {exc}"
+        except Exception as exc:  # noqa: BLE001 - never let pythonfmu see an exception (module doc)
+            self.error = f"initialisation failed: {type(exc).__name__}: {exc}"
+        self.slave.log(f"{self.slave.instance_name}: {self.error}", Fmi2Status.error)
+        return None
+
+    def step(self, fn: Callable[[], None]) -> bool:
+        """Run one step's work ``fn``; return False (fmi2Discard) after logging if the slave
+        was refused at initialisation or ``fn`` raises."""
+        if self.error is None:
+            try:
+                fn()
+                return True
+            except Exception as exc:  # noqa: BLE001 - never let pythonfmu see an exception
+                self.error = f"step failed: {type(exc).__name__}: {exc}"
+        self.slave.log(f"{self.slave.instance_name}: {self.error}; the FMU cannot step", Fmi2Status.error)
+        return False
 
     def set_outputs(self, reals: list[float], booleans: list[bool] | None = None) -> None:
         """Replace the output values in place (the getters hold references to these lists)."""

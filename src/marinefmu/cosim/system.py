@@ -205,11 +205,17 @@ class SystemRunner:
                 wires.append((con, a, b))
             fields = self._record_fields(instances, record)
             for name, inst in instances.items():
+                logged = len(self.messages)
                 try:
                     inst.fmu.enterInitializationMode()
                     inst.fmu.exitInitializationMode()
                 except Exception as exc:  # FMPy raises FMICallException
                     raise self._fail(name, "initialisation", t0, exc) from None
+                # marinefmu slaves refuse a parameter by logging an error (they never raise:
+                # see marinefmu.cosim.slave), so an error logged here is a refusal
+                refused = [m for m in self.messages[logged:] if m.instance == name and m.status in ("ERROR", "FATAL")]
+                if refused:
+                    raise self._fail(name, "initialisation", t0, RuntimeError(refused[0].text))
             out = np.zeros(n_steps + 1, dtype=[("time", "f8")] + [(f, "?" if k == "Boolean" else "f8") for f, (_, k, _) in fields.items()])
             getters = self._getters(instances, fields)
             rates = {c.name: c.rate for c in sysd.components}
