@@ -1,0 +1,35 @@
+"""The command line, run as a user would (short durations)."""
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from marinefmu.cli import main
+from marinefmu.cosim.system import load_csv
+
+pytestmark = pytest.mark.fmu
+
+
+def test_simulate_default_writes_csv_plots_and_system_file(fmu_dir, tmp_path, capsys):
+    assert main(["simulate", "default", "--duration", "20", "--out", str(tmp_path), "--fmus", str(fmu_dir), "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "hs_realised_m" in out and "summary of vessel" in out
+    r = load_csv(tmp_path / "results.csv")
+    assert r["time"][-1] == pytest.approx(20.0) and r.size == 2001
+    assert np.std(r["vessel.truth.cog.d"]) > 0.05
+    for name in ("vessel_motion.png", "vessel_imu.png", "vessel_gnss.png", "SystemStructure.ssd"):
+        assert (tmp_path / name).stat().st_size > 1000
+
+
+def test_simulate_reports_a_bad_scenario_with_exit_code_2(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[scenario]\nduration = 5.0\n[components.v]\nfmu = "VesselMotion"\n[components.v.parameters]\n"sea.hs" = -2.0\n')
+    assert main(["simulate", str(bad), "--out", str(tmp_path / "o"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "sea.hs = -2.0 is out of range" in err
+
+
+def test_console_script_is_installed():
+    out = subprocess.run([sys.executable, "-m", "marinefmu.cli", "--help"], capture_output=True, text=True, check=True).stdout
+    assert "simulate" in out and "build" in out and "bench" in out
