@@ -101,3 +101,21 @@ def test_a_step_failure_is_reported_with_component_time_and_messages(fmu_dir, re
                              (Connection.parse("v.truth.cog.d", "r.gain"),), 0.01, 0.1)
     with pytest.raises(SystemError_, match=r"r\.gain has causality 'parameter', expected input"):
         SystemRunner(sysd, tmp_path).run(progress=False)
+
+
+def test_build_skips_unchanged_models_and_rebuilds_a_changed_one(tmp_path):
+    import shutil
+    from pathlib import Path
+
+    from marinefmu.cosim.build import build_all
+
+    models = tmp_path / "models"
+    models.mkdir()
+    shutil.copy(Path(__file__).parent / "models" / "MfTestRelay.py", models)
+    dest = tmp_path / "fmus"
+    assert [r.rebuilt for r in build_all(models, dest, verbose=False)] == [True]
+    stamp = (dest / "MfTestRelay.fmu").stat().st_mtime_ns
+    assert [r.rebuilt for r in build_all(models, dest, verbose=False)] == [False]
+    assert (dest / "MfTestRelay.fmu").stat().st_mtime_ns == stamp
+    (models / "MfTestRelay.py").write_text((models / "MfTestRelay.py").read_text() + "\n# changed\n")
+    assert [r.rebuilt for r in build_all(models, dest, verbose=False)] == [True]

@@ -136,11 +136,6 @@ def rigid_point_operator(w: list[float], a: list[float]) -> np.ndarray:
     )
 
 
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product of two 3-vectors (faster than ``numpy.cross`` for single vectors)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 def specific_force(rot: np.ndarray, acc_n: np.ndarray) -> np.ndarray:
     """Specific force in the body frame, f_b = R_nbᵀ (a_n − g_n) [m/s²]."""
     return rot.T @ (acc_n - GRAVITY_N)

@@ -28,7 +28,7 @@ Motion modes (``vessel.mode``):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -180,10 +180,6 @@ class VesselMotionParams:
         return cls(sea=sea, preset=v["vessel.preset"], rao_file=v["vessel.rao_file"], speed=v["vessel.speed"],
                    mode=v["vessel.mode"], cr=xyz("vessel.cr"), imu=imu, gnss=gnss, point=xyz("point"),
                    sensor_seed=v["sensors.seed"])
-
-    def with_sea(self, **changes: Any) -> "VesselMotionParams":
-        """Copy with sea-state fields changed (convenience for sweeps)."""
-        return replace(self, sea=replace(self.sea, **changes))
 
 
 @dataclass(frozen=True)
