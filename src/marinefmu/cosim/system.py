@@ -196,13 +196,14 @@ class SystemRunner:
                 for name, value in comp.parameters.items():
                     inst.set_value(name, value)
             # wiring, checked before anything steps
-            wires = []
+            wires = []  # (end component, getter, source vr, setter, destination vr), resolved once
             for con in sysd.connections:
                 a = instances[con.start].variable(con.start_var, ("output",))
                 b = instances[con.end].variable(con.end_var, ("input",))
                 if a.type != b.type:
                     raise SystemError_(f"connection {con}: {a.type} output cannot feed {b.type} input")
-                wires.append((con, a, b))
+                wires.append((con.end, _accessor(instances[con.start].fmu, "get", a.type), [a.valueReference],
+                              _accessor(instances[con.end].fmu, "set", b.type), [b.valueReference]))
             fields = self._record_fields(instances, record)
             for name, inst in instances.items():
                 logged = len(self.messages)
@@ -219,7 +220,7 @@ class SystemRunner:
             out = np.zeros(n_steps + 1, dtype=[("time", "f8")] + [(f, "?" if k == "Boolean" else "f8") for f, (_, k, _) in fields.items()])
             getters = self._getters(instances, fields)
             rates = {c.name: c.rate for c in sysd.components}
-            self._transfer(instances, wires, set(instances))
+            self._transfer(wires, set(instances))
             self._sample(out, 0, t0, getters)
             bar = tqdm(total=n_steps, unit="step", disable=not (progress if progress is not None else n_steps > 2000),
                        desc=sysd.name, mininterval=0.5)
@@ -227,7 +228,7 @@ class SystemRunner:
                 for k in range(n_steps):
                     t = t0 + k * sysd.step
                     due = {n for n, m in rates.items() if k % m == 0}
-                    self._transfer(instances, wires, due)
+                    self._transfer(wires, due)
                     for name in due:
                         try:
                             instances[name].fmu.doStep(currentCommunicationPoint=t, communicationStepSize=rates[name] * sysd.step)
@@ -276,9 +277,7 @@ class SystemRunner:
             names.append(f)
         result = []
         for (comp, kind), (vrs, names) in groups.items():
-            fmu = instances[comp].fmu
-            get = {"Real": fmu.getReal, "Boolean": fmu.getBoolean, "Integer": fmu.getInteger}[kind]
-            result.append((get, vrs, names))
+            result.append((_accessor(instances[comp].fmu, "get", kind), vrs, names))
         return result
 
     @staticmethod
@@ -289,16 +288,16 @@ class SystemRunner:
                 out[name][row] = value
 
     @staticmethod
-    def _transfer(instances, wires, due: set[str]) -> None:
-        values = []
-        for con, a, b in wires:
-            if con.end in due:
-                src = instances[con.start].fmu
-                get = {"Real": src.getReal, "Boolean": src.getBoolean, "Integer": src.getInteger}[a.type]
-                values.append((con, b, get([a.valueReference])[0]))
-        for con, b, value in values:
-            dst = instances[con.end].fmu
-            {"Real": dst.setReal, "Boolean": dst.setBoolean, "Integer": dst.setInteger}[b.type]([b.valueReference], [value])
+    def _transfer(wires, due: set[str]) -> None:
+        # read every due input's source first, then set: all inputs see the outputs held at t
+        values = [(set_, dst_vr, get(src_vr)) for end, get, src_vr, set_, dst_vr in wires if end in due]
+        for set_, dst_vr, value in values:
+            set_(dst_vr, value)
+
+
+def _accessor(fmu: Any, op: str, kind: str):
+    """The FMU2Slave method ``getReal``/``setBoolean``/… for a variable type."""
+    return getattr(fmu, f"{op}{'Integer' if kind == 'Enumeration' else kind}")
 
 
 def save_csv(result: np.ndarray, path: str | Path) -> Path:
