@@ -139,3 +139,81 @@ def rigid_point_operator(w: list[float], a: list[float]) -> np.ndarray:
 def specific_force(rot: np.ndarray, acc_n: np.ndarray) -> np.ndarray:
     """Specific force in the body frame, f_b = R_nbᵀ (a_n − g_n) [m/s²]."""
     return rot.T @ (acc_n - GRAVITY_N)
+
+
+# --- Unit quaternions q = [w, x, y, z] (scalar first, Hamilton product) representing R_nb --------
+# v_n = q ⊗ [0, v_b] ⊗ q*. Hand-written for the per-step hot path (scipy's Rotation costs tens of
+# µs per call); the tests check every function against scipy.spatial.transform.Rotation.
+
+
+def quat_mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Hamilton product p ⊗ q of quaternions [w, x, y, z] (paper 000, eq. 4)."""
+    pw, px, py, pz = p
+    qw, qx, qy, qz = q
+    return np.array([
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    ])
+
+
+def quat_from_rotvec(v: np.ndarray) -> np.ndarray:
+    """Exact unit quaternion of the rotation vector ``v`` [rad]: [cos(|v|/2), sin(|v|/2) v/|v|].
+
+    Uses the Taylor series of sin(x/2)/x below |v| = 1e-4 rad so that tiny rotations keep
+    full precision.
+    """
+    vx, vy, vz = v
+    a2 = vx * vx + vy * vy + vz * vz
+    if a2 < 1e-8:
+        s = 0.5 - a2 / 48.0
+        c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0
+    else:
+        a = math.sqrt(a2)
+        s = math.sin(0.5 * a) / a
+        c = math.cos(0.5 * a)
+    return np.array([c, s * vx, s * vy, s * vz])
+
+
+def quat_to_rot(q: np.ndarray) -> np.ndarray:
+    """R_nb of the unit quaternion ``q`` (the transpose of C_e in paper 000, eq. 8)."""
+    w, x, y, z = q
+    return np.array([
+        [w * w + x * x - y * y - z * z, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
+        [2.0 * (x * y + w * z), w * w - x * x + y * y - z * z, 2.0 * (y * z - w * x)],
+        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), w * w - x * x - y * y + z * z],
+    ])
+
+
+def quat_to_euler(q: np.ndarray) -> tuple[float, float, float]:
+    """ZYX Euler angles (roll, pitch, yaw) [rad] of ``q`` (paper 000, eq. 9).
+
+    The extracted text of eq. 9 has a sign slip in the yaw denominator
+    (q0² + q1² + q2² − q3²); the correct ZYX form, used here, is q0² + q1² − q2² − q3².
+    """
+    w, x, y, z = q
+    roll = math.atan2(2.0 * (y * z + w * x), w * w - x * x - y * y + z * z)
+    pitch = -math.asin(max(-1.0, min(1.0, 2.0 * (x * z - w * y))))
+    yaw = math.atan2(2.0 * (x * y + w * z), w * w + x * x - y * y - z * z)
+    return roll, pitch, yaw
+
+
+def euler_to_quat(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """Unit quaternion of R_nb = Rz(ψ) Ry(θ) Rx(φ)."""
+    cr, sr = math.cos(0.5 * roll), math.sin(0.5 * roll)
+    cp, sp = math.cos(0.5 * pitch), math.sin(0.5 * pitch)
+    cy, sy = math.cos(0.5 * yaw), math.sin(0.5 * yaw)
+    return np.array([
+        cy * cp * cr + sy * sp * sr,
+        cy * cp * sr - sy * sp * cr,
+        cy * sp * cr + sy * cp * sr,
+        sy * cp * cr - cy * sp * sr,
+    ])
+
+
+def level_angles(f_b: np.ndarray) -> tuple[float, float]:
+    """Roll and pitch [rad] that make the specific force ``f_b`` [m/s², b] point straight up
+    (f_b = R_nbᵀ(−g_n) for a sensor at rest): φ = atan2(−f_y, −f_z), θ = atan2(f_x, √(f_y² + f_z²))."""
+    fx, fy, fz = f_b
+    return math.atan2(-fy, -fz), math.atan2(fx, math.hypot(fy, fz))
