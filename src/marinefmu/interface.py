@@ -5,8 +5,9 @@ interface and ``cosim/`` can register it with pythonfmu and write units into the
 """
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 Kind = Literal["real", "integer", "boolean", "string"]
 
@@ -46,3 +47,22 @@ def vec(prefix: str, axes: str | tuple[str, ...], default, unit: str, descriptio
     names = tuple(axes)
     defaults = default if isinstance(default, (tuple, list)) else (default,) * len(names)
     return [real(f"{prefix}.{a}", d, unit, f"{description}, {a}") for a, d in zip(names, defaults)]
+
+
+def resolve(table: list[Variable], values: dict[str, Any], what: str) -> dict[str, Any]:
+    """Every parameter of ``table`` with its value from ``values`` or its default.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown name, with the closest known name as a hint.
+    """
+    from .errors import ParameterError
+
+    known = {v.name: v for v in table}
+    unknown = [k for k in values if k not in known]
+    if unknown:
+        hints = {k: difflib.get_close_matches(k, known, n=1) for k in unknown}
+        msg = "; ".join(f"{k!r}" + (f" (did you mean {h[0]!r}?)" if h else "") for k, h in hints.items())
+        raise ParameterError(f"unknown {what} parameter(s): {msg}")
+    return {name: values.get(name, var.default) for name, var in known.items()}

@@ -65,6 +65,8 @@ class SlaveIO:
         self.start_time = 0.0
         #: Why the slave cannot step (refused parameter or failed step), else None.
         self.error: str | None = None
+        self._warning: str | None = None
+        self._repeats = 0
         #: FMI unit of every registered variable (read by the build to write UnitDefinitions).
         self.units: dict[str, str] = {v.name: v.unit for v in (*parameters, *inputs, *outputs, *boolean_outputs)}
         for v in parameters:
@@ -122,6 +124,23 @@ class SlaveIO:
                 self.error = f"step failed: {type(exc).__name__}: {exc}"
         self.slave.log(f"{self.slave.instance_name}: {self.error}; the FMU cannot step", Fmi2Status.error)
         return False
+
+    def warn(self, message: str | None, time: float) -> None:
+        """Report a rejected sample (``message``) or a good one (None) as an FMU warning.
+
+        A run of identical rejections is logged once when it starts and once, with its
+        length, when it ends, so a long sensor outage is visible without flooding the log.
+        """
+        if message == self._warning:
+            self._repeats += message is not None
+            return
+        if self._warning is not None:
+            self.slave.log(f"{self.slave.instance_name}: t = {time:.4f} s: {self._warning} ended after {self._repeats + 1} step(s)",
+                           Fmi2Status.warning)
+        if message is not None:
+            self.slave.log(f"{self.slave.instance_name}: t = {time:.4f} s: {message}; holding/coasting, valid = false",
+                           Fmi2Status.warning)
+        self._warning, self._repeats = message, 0
 
     def set_outputs(self, reals: list[float], booleans: list[bool] | None = None) -> None:
         """Replace the output values in place (the getters hold references to these lists)."""

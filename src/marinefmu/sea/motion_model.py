@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import ParameterError, check_choice, check_int, check_vector
 from ..frames import attitude_kinematics, rigid_point_operator, specific_force
-from ..interface import Variable, real, vec
+from ..interface import Variable, real, resolve, vec
 from .sensors import ANTENNAS, Gnss, GnssParams, Imu, ImuParams
 from .vessel import PRESETS, MotionSeries, RaoTable, check_speed, load_rao_csv, preset_raos
 from .waves import SPECTRA, SeaState, realise
@@ -147,15 +147,7 @@ class VesselMotionParams:
         ParameterError
             For an unknown name (with the closest known names) or an invalid value.
         """
-        known = {v.name: v for v in PARAMETERS}
-        unknown = [k for k in values if k not in known]
-        if unknown:
-            import difflib
-
-            hints = {k: difflib.get_close_matches(k, known, n=1) for k in unknown}
-            msg = "; ".join(f"{k!r}" + (f" (did you mean {h[0]!r}?)" if h else "") for k, h in hints.items())
-            raise ParameterError(f"unknown VesselMotion parameter(s): {msg}")
-        v = {name: values.get(name, var.default) for name, var in known.items()}
+        v = resolve(PARAMETERS, values, "VesselMotion")
 
         def xyz(p: str, axes: str = "xyz") -> tuple[float, ...]:
             return tuple(v[f"{p}.{a}"] for a in axes)

@@ -1,0 +1,92 @@
+"""FMU variable tables of the estimator FMUs and the mapping from FMI values to the estimators'
+parameter objects (kept out of ``estimators/``, which must not know about FMI names)."""
+from __future__ import annotations
+
+from typing import Any
+
+from ..estimators.attitude import INIT_CHOICES, AttitudeParams
+from ..estimators.reconstruction import TILT_CHOICES
+from ..estimators.sliding_reconstruction import SlidingParams
+from ..interface import Variable, real, resolve, vec
+
+_ATT = AttitudeParams()
+ATTITUDE_PARAMETERS: list[Variable] = [
+    Variable("mode", "integer", 1, "", "0 gyro-only quaternion integration (paper 000), 1 drift-corrected (aided)"),
+    Variable("init", "string", "level", "", f"Initial attitude: one of {', '.join(INIT_CHOICES)}"),
+    real("init.roll", 0.0, "rad", "Initial roll for init = given"),
+    real("init.pitch", 0.0, "rad", "Initial pitch for init = given"),
+    real("init.yaw", 0.0, "rad", "Initial yaw (init = given or level)"),
+    real("level_time", _ATT.level_time, "s", "Levelling time for init = level, 0.1..600"),
+    real("gyro_noise", _ATT.gyro_noise, "rad/s/sqrt(Hz)", "Gyro white-noise density, (0, 1]"),
+    real("acc_noise", _ATT.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 10]"),
+    real("gyro_bias_sigma", _ATT.gyro_bias_sigma, "rad/s", "Gyro bias standard deviation, (0, 1]"),
+    real("gyro_bias_tau", _ATT.gyro_bias_tau, "s", "Gyro bias correlation time, 1..1e6"),
+    real("vel_sigma", _ATT.vel_sigma, "m/s", "Zero-velocity pseudo-measurement standard deviation, (0, 100]"),
+    real("pos_sigma", _ATT.pos_sigma, "m", "Zero-position pseudo-measurement standard deviation, (0, 1000]"),
+    real("aid_rate", _ATT.aid_rate, "Hz", "Pseudo-measurement rate, (0, 100]"),
+]
+ATTITUDE_INPUTS: list[Variable] = [
+    *vec("gyro", "xyz", 0.0, "rad/s", "Angular rate, body frame"),
+    *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force, body frame"),
+]
+ATTITUDE_OUTPUTS: list[Variable] = [
+    real("roll", 0.0, "rad", "Estimated roll (ZYX Euler)"),
+    real("pitch", 0.0, "rad", "Estimated pitch (ZYX Euler)"),
+    real("yaw", 0.0, "rad", "Estimated yaw (ZYX Euler; gyro-integrated, drifts without a heading aid)"),
+    *vec("q", "wxyz", (1.0, 0.0, 0.0, 0.0), "", "Unit quaternion of R_nb (body to NED)"),
+    *vec("gyro_bias", "xyz", 0.0, "rad/s", "Estimated gyro bias, body frame (z not observable)"),
+]
+ATTITUDE_BOOLEANS: list[Variable] = [
+    Variable("valid", "boolean", False, "", "False while levelling and on a rejected (NaN/Inf/absurd) sample"),
+]
+
+_SL = SlidingParams()
+RECONSTRUCTOR_PARAMETERS: list[Variable] = [
+    real("window", _SL.window, "s", "Sliding window length, >= 2/cutoff, <= 3600"),
+    real("hop", _SL.hop, "s", "Refit interval, (0, window]"),
+    real("cutoff", _SL.cutoff, "Hz", "Screening frequency F (paper 000 eq. 25), (0, Nyquist)"),
+    Variable("max_components", "integer", _SL.max_components, "", "Most complex-exponential components per axis, 1..2000"),
+    *vec("lever_arm", "xyz", 0.0, "m", "Sensor position relative to the COG, body frame"),
+    real("fmax", _SL.fmax, "Hz", "Highest motion frequency (decimation), (cutoff, Nyquist]"),
+    Variable("tilt", "string", _SL.tilt, "", f"Tilt correction: one of {', '.join(TILT_CHOICES)}"),
+    real("max_damping", _SL.max_damping, "", "Screen components with |damping ratio| above this, (0, 1]"),
+    real("sc_tol", _SL.sc_tol, "", "Relative residual stopping threshold, (0, 1)"),
+]
+RECONSTRUCTOR_INPUTS: list[Variable] = [
+    *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force, body frame"),
+    real("roll", 0.0, "rad", "Roll (ZYX Euler)"),
+    real("pitch", 0.0, "rad", "Pitch (ZYX Euler)"),
+    real("yaw", 0.0, "rad", "Yaw (ZYX Euler)"),
+]
+RECONSTRUCTOR_OUTPUTS: list[Variable] = [
+    *vec("disp", "ned", 0.0, "m", "COG displacement at the latest sample (window model extrapolated by latency), NED"),
+    *vec("vel", "ned", 0.0, "m/s", "COG velocity at the latest sample, NED"),
+    *vec("centred.disp", "ned", 0.0, "m", "COG displacement at time - centred.delay (window centre), NED"),
+    *vec("centred.vel", "ned", 0.0, "m/s", "COG velocity at time - centred.delay, NED"),
+    real("centred.delay", 0.5 * _SL.window, "s", "Delay of the centred estimate (window / 2)"),
+    real("latency", 0.0, "s", "Time from the end of the fitted window to the latest sample"),
+]
+RECONSTRUCTOR_BOOLEANS: list[Variable] = [
+    Variable("valid", "boolean", False, "", "False until the first window is full, on a rejected sample, and while >1 % of the fitted window was replaced"),
+]
+
+
+def attitude_params(values: dict[str, Any]) -> AttitudeParams:
+    """AttitudeParams from FMI-named values."""
+    v = resolve(ATTITUDE_PARAMETERS, values, "AttitudeEstimator")
+    return AttitudeParams(
+        mode=v["mode"], init=v["init"], init_euler=(v["init.roll"], v["init.pitch"], v["init.yaw"]),
+        level_time=v["level_time"], gyro_noise=v["gyro_noise"], acc_noise=v["acc_noise"],
+        gyro_bias_sigma=v["gyro_bias_sigma"], gyro_bias_tau=v["gyro_bias_tau"], vel_sigma=v["vel_sigma"],
+        pos_sigma=v["pos_sigma"], aid_rate=v["aid_rate"],
+    )
+
+
+def sliding_params(values: dict[str, Any]) -> SlidingParams:
+    """SlidingParams from FMI-named values."""
+    v = resolve(RECONSTRUCTOR_PARAMETERS, values, "DisplacementReconstructor")
+    return SlidingParams(
+        window=v["window"], hop=v["hop"], cutoff=v["cutoff"], max_components=v["max_components"],
+        lever_arm=(v["lever_arm.x"], v["lever_arm.y"], v["lever_arm.z"]), fmax=v["fmax"], tilt=v["tilt"],
+        max_damping=v["max_damping"], sc_tol=v["sc_tol"],
+    )
