@@ -323,7 +323,7 @@ class AttitudeEstimator:
     def get_state(self) -> dict:
         """JSON-serialisable internal state (quaternion, bias, velocity, filter, levelling)."""
         return {
-            "q": self.q.tolist(), "bias": self.bias.tolist(), "vel": self.vel.tolist(),
+            "q": self.q.tolist(), "bias": self.bias.tolist(), "vel": self.vel.tolist(), "pos": self.pos.tolist(),
             "last_gyro": None if self.last_gyro is None else self.last_gyro.tolist(),
             "last_acc": None if self.last_acc is None else self.last_acc.tolist(),
             "levelling": self.levelling, "level_steps": self.level_steps, "level_sum": self.level_sum.tolist(),
@@ -336,6 +336,7 @@ class AttitudeEstimator:
         self.q = np.array(s["q"])
         self.bias = np.array(s["bias"])
         self.vel = np.array(s["vel"])
+        self.pos = np.array(s["pos"])
         self.last_gyro = None if s["last_gyro"] is None else np.array(s["last_gyro"])
         self.last_acc = None if s["last_acc"] is None else np.array(s["last_acc"])
         self.levelling, self.level_steps = bool(s["levelling"]), int(s["level_steps"])
