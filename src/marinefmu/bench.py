@@ -95,6 +95,28 @@ def _runner_rate(fmu_dir: Path, steps: int) -> float:
     return steps / (time.perf_counter() - t0)
 
 
+def reconstruction_seconds(hours: float = 1.0) -> dict[str, float]:
+    """Wall time [s] of :func:`~marinefmu.estimators.reconstruction.reconstruct_displacement`
+    on ``hours`` of 100 Hz three-axis acceleration (VesselMotion semisub, noise-free), and the
+    DisplacementReconstructor's mean cost per step [µs] over 400 s (refits included)."""
+    from .estimators.reconstruction import reconstruct_displacement, tilt_correct
+    from .estimators.sliding_reconstruction import SlidingParams, SlidingReconstructor
+    from .examples.paper000_semisub import simulate
+
+    rec = simulate(3600.0 * hours, noise=True)
+    acc = tilt_correct(rec["acc"], rec["euler"])
+    t0 = time.perf_counter()
+    reconstruct_displacement(acc, 0.01, 0.03)
+    batch = time.perf_counter() - t0
+    sr = SlidingReconstructor(SlidingParams(window=200.0, hop=10.0), dt=0.01)
+    n = 40000
+    t0 = time.perf_counter()
+    for k in range(n):
+        sr.step(rec["acc"][k], rec["euler"][k], 0.01)
+    per_step = (time.perf_counter() - t0) / n * 1e6
+    return {"batch_1h_100hz_3axis_s": batch, "sliding_per_step_us": per_step}
+
+
 def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None) -> dict:
     """Run every measurement, write ``out_dir/bench.json`` and print a table; return the data."""
     from .cosim.build import build_all, repo_root
@@ -112,7 +134,9 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
         "system_runner": _best(lambda: _runner_rate(fmu_dir, steps)),
     }
     three_hours = 3 * 3600 / DT
+    recon = reconstruction_seconds()
     data = {
+        "reconstruction": recon,
         "date": datetime.date.today().isoformat(),
         "machine": machine(),
         "setup": {"model": "VesselMotion", "wave_components": 200, "step_s": DT, "steps": steps, "repeats": 3},
@@ -126,5 +150,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     print(f"{'measurement':24s} {'steps/s':>10s} {'3 h @ 100 Hz':>14s}")
     for k, v in rates.items():
         print(f"{k:24s} {v:10,.0f} {three_hours / v:12.1f} s")
+    print(f"reconstruct_displacement, 1 h of 100 Hz 3-axis acceleration: {recon['batch_1h_100hz_3axis_s']:.1f} s (goal <= 10 s)")
+    print(f"DisplacementReconstructor per step (200 s window, 10 s hop, refits included): {recon['sliding_per_step_us']:.0f} µs")
     print(f"wrote {out_dir / 'bench.json'}")
     return data
