@@ -51,7 +51,7 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 from ..errors import check_choice, check_int, check_range, check_vector
-from ..frames import G, euler_to_quat, level_angles, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
+from ..frames import euler_to_quat, level_angles, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
 
 log = logging.getLogger(__name__)
 

@@ -29,6 +29,7 @@ from ..errors import check_choice, check_range, check_vector
 from ..frames import G, rot_nb
 from .reconstruction import (
     TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, lowpass_decimate,
+    tilt_correct,
 )
 
 log = logging.getLogger(__name__)
@@ -133,7 +134,8 @@ class SlidingReconstructor:
     def reset(self) -> None:
         """Empty the window."""
         n = self.n_win
-        self.acc = np.zeros((n, 3))
+        self.acc = np.zeros((n, 3))  # specific force [m/s², b]; tilt-corrected at each refit
+        self.euler = np.zeros((n, 3))
         self.arm = np.zeros((n, 3))
         self.bad = np.zeros(n, dtype=bool)
         self.k = 0  # samples received
@@ -169,19 +171,16 @@ class SlidingReconstructor:
                 acc, euler = self.last_good
         else:
             self.last_good = (acc, euler)
-        rot = rot_nb(*euler)
-        if self.params.tilt == "exact":
-            a = rot @ acc + np.array([0.0, 0.0, G])
-        else:
-            a = acc + G * np.array([-euler[1], euler[0], 1.0])
         i = self.k % self.n_win
-        self.acc[i] = a
-        self.arm[i] = rot @ self.lever
+        self.acc[i] = acc
+        self.euler[i] = euler
+        arm = rot_nb(*euler) @ self.lever
+        self.arm[i] = arm
         self.bad[i] = warning is not None
         self.k += 1
         if self.k >= self.n_win and (self.k - self.n_win) % self.n_hop == 0:
             self._refit()
-        return self._outputs(rot @ self.lever, warning)
+        return self._outputs(arm, warning)
 
     def _ordered(self, buf: np.ndarray) -> np.ndarray:
         i = self.k % self.n_win
@@ -189,7 +188,7 @@ class SlidingReconstructor:
 
     def _refit(self) -> None:
         p, dt = self.params, self.dt
-        acc = self._ordered(self.acc)
+        acc = tilt_correct(self._ordered(self.acc), self._ordered(self.euler), p.tilt)
         arm = self._ordered(self.arm)
         self.t_start = (self.k - self.n_win) * dt
         xd = lowpass_decimate(acc, self.q)
@@ -242,7 +241,7 @@ class SlidingReconstructor:
             [[lam.real.tolist(), lam.imag.tolist()], [c2.real.tolist(), c2.imag.tolist()], [c1.real.tolist(), c1.imag.tolist()]]
             for lam, c2, c1 in self.models]
         return {
-            "dt": self.dt, "acc": self.acc.tolist(), "arm": self.arm.tolist(), "bad": self.bad.tolist(), "k": self.k,
+            "dt": self.dt, "acc": self.acc.tolist(), "euler": self.euler.tolist(), "arm": self.arm.tolist(), "bad": self.bad.tolist(), "k": self.k,
             "last_good": None if self.last_good is None else [self.last_good[0].tolist(), self.last_good[1].tolist()],
             "models": models, "t_start": self.t_start, "trend": self.trend.tolist(), "fit_bad_fraction": self.fit_bad_fraction,
         }
@@ -253,7 +252,8 @@ class SlidingReconstructor:
             self.dt = None
             return
         self.configure(s["dt"])
-        self.acc, self.arm, self.bad = np.array(s["acc"]), np.array(s["arm"]), np.array(s["bad"], dtype=bool)
+        self.acc, self.euler = np.array(s["acc"]), np.array(s["euler"])
+        self.arm, self.bad = np.array(s["arm"]), np.array(s["bad"], dtype=bool)
         self.k = int(s["k"])
         self.last_good = None if s["last_good"] is None else (np.array(s["last_good"][0]), np.array(s["last_good"][1]))
         self.models = None if s["models"] is None else [
