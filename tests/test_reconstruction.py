@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.reconstruction import decompose, reconstruct_displacement, tilt_correct
+from marinefmu.estimators.reconstruction import (_complex_least_squares, _least_squares_amplitudes, decompose,
+                                                 exp_grid, reconstruct_displacement, tilt_correct)
 from marinefmu.estimators.sliding_reconstruction import SlidingParams, SlidingReconstructor
 from marinefmu.examples import paper000_sdof, paper000_semisub
 
@@ -34,6 +35,24 @@ def test_closed_form_damped_sinusoid_and_offset_recovered_to_1e_8():
     np.testing.assert_allclose(rec.displacement, exact, atol=1e-8)
     np.testing.assert_allclose(rec.velocity, 2 * np.real(GAM / LAM * np.exp(LAM * t)), atol=1e-8)
     assert list(rec.components["kept"]) == [False, True]
+
+
+def test_exp_grid_matches_numpy_exp_to_a_few_ulp():
+    lam = np.array([-0.05 + 2j * math.pi * 0.2, -0.05 - 2j * math.pi * 0.2, 0.0, -0.3, 0.001 + 3j])
+    n, dt = 1000, 0.2
+    ref = np.exp(np.multiply.outer(np.arange(n) * dt, lam))
+    np.testing.assert_allclose(exp_grid(lam, dt, n), ref, rtol=1e-12, atol=0)
+
+
+def test_real_least_squares_equals_the_complex_solve():
+    rng = np.random.default_rng(5)
+    lam = np.array([-0.02 + 1.2j, -0.02 - 1.2j, -0.1 + 0.4j, -0.1 - 0.4j, 0.0, -0.5])
+    x = rng.normal(size=400)
+    g_real, fit_real = _least_squares_amplitudes(x, lam, 0.2, with_fit=True)
+    g_cplx, fit_cplx = _complex_least_squares(x, lam, 0.2, with_fit=True)
+    np.testing.assert_allclose(g_real, g_cplx, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(fit_real, fit_cplx, atol=1e-10)
+    np.testing.assert_allclose(g_real[0], np.conj(g_real[1]), rtol=0, atol=0)  # exact pairs
 
 
 def test_sdof_example_of_section_4():

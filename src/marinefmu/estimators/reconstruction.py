@@ -197,6 +197,15 @@ class Decomposition:
         tt = np.asarray(t, dtype=float) - self.t0
         return np.real(np.exp(np.multiply.outer(tt, lam)) @ coef)
 
+    def evaluate_grid(self, start: float, dt: float, n: int, powers: tuple[int, ...] = (2, 1, 0)) -> np.ndarray:
+        """(n, len(powers)) kept-component sums of :meth:`evaluate` on the uniform grid
+        t = start + k·dt, k = 0 … n − 1, sharing one exponential matrix (:func:`exp_grid`)."""
+        lam, gam = self.lam[self.kept], self.gamma[self.kept]
+        if len(lam) == 0:
+            return np.zeros((n, len(powers)))
+        coef = np.stack([gam / lam ** pw for pw in powers], axis=1) * np.exp(lam * (start - self.t0))[:, None]
+        return np.real(exp_grid(lam, dt, n) @ coef)
+
     def table(self, axis: int = 0, segment: int = 0) -> np.ndarray:
         """One row per component of :data:`COMPONENT_DTYPE` (conjugate partners dropped)."""
         pos = self.lam.imag >= 0
@@ -222,9 +231,13 @@ def hankel_pair(x: np.ndarray, rows: int) -> tuple[np.ndarray, np.ndarray]:
 
 def truncated_svd(h: np.ndarray, k: int, rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Leading ``k`` singular triplets of ``h``: full LAPACK SVD when ``h`` is small, else a
-    randomised SVD (Halko et al. 2011, algorithm 4.4 with 2 power iterations, oversampling 20)."""
+    randomised SVD (Halko et al. 2011, algorithm 4.4 with 2 power iterations, oversampling 20).
+
+    The switch is at min(m, n) = 7·(k + 20), where the two cost the same on this project's
+    reference machine (measured 2026-11-22 for k = 123: 484 rows full 37 ms vs randomised
+    83 ms; 1200 rows full 335 ms vs randomised 201 ms)."""
     m, n = h.shape
-    if min(m, n) <= 3 * (k + 20):
+    if min(m, n) <= 7 * (k + 20):
         u, s, vt = linalg.svd(h, full_matrices=False, lapack_driver="gesdd", check_finite=False)
         return u[:, :k], s[:k], vt[:k]
     rng = rng or np.random.default_rng(0)
@@ -238,10 +251,17 @@ def truncated_svd(h: np.ndarray, k: int, rng: np.random.Generator | None = None)
     return (q @ ub)[:, :k], s[:k], vt[:k]
 
 
-def _poles_amplitudes(u: np.ndarray, s: np.ndarray, vt: np.ndarray, h1: np.ndarray, od: int) -> tuple[np.ndarray, np.ndarray]:
-    """Discrete poles μ (eq. 19) and ERA amplitudes of the order-``od`` realisation."""
+def _project(u: np.ndarray, h1: np.ndarray, vt: np.ndarray) -> np.ndarray:
+    """Uᵀ H(1) V (k × k) of the leading k singular vectors: the system matrix of every order
+    od ≤ k is built from its leading od × od block (eq. 19), so one product serves all orders."""
+    return u.T @ (h1 @ vt.T)
+
+
+def _poles_amplitudes(u: np.ndarray, s: np.ndarray, vt: np.ndarray, p: np.ndarray, od: int) -> tuple[np.ndarray, np.ndarray]:
+    """Discrete poles μ (eq. 19) and ERA amplitudes of the order-``od`` realisation;
+    ``p`` = :func:`_project` (U, H(1), V)."""
     si = 1.0 / np.sqrt(s[:od])
-    a = (si[:, None] * (u[:, :od].T @ h1 @ vt[:od].T)) * si[None, :]
+    a = (si[:, None] * p[:od, :od]) * si[None, :]
     mu, psi = linalg.eig(a, check_finite=False)
     sq = np.sqrt(s[:od])
     c = u[0, :od] * sq
@@ -253,11 +273,11 @@ def _poles_amplitudes(u: np.ndarray, s: np.ndarray, vt: np.ndarray, h1: np.ndarr
     return mu, gamma
 
 
-def _poles(u: np.ndarray, s: np.ndarray, vt: np.ndarray, h1: np.ndarray, od: int, dt: float, n: int) -> np.ndarray:
+def _poles(u: np.ndarray, s: np.ndarray, vt: np.ndarray, p: np.ndarray, od: int, dt: float, n: int) -> np.ndarray:
     """Continuous poles λ = ln(μ)/Δt of the order-``od`` realisation, without the numerically
     dead ones (μ = 0) and the spurious ones that grow by more than e^30 over the ``n`` samples
     (they cannot describe a measured record and overflow when evaluated)."""
-    mu, _ = _poles_amplitudes(u, s, vt, h1, od)
+    mu, _ = _poles_amplitudes(u, s, vt, p, od)
     return _clean_poles(mu, dt, n)
 
 
@@ -280,7 +300,7 @@ def _order_from_energy(h0: np.ndarray, s: np.ndarray, limit: int, tol: float) ->
     return od, float(rel[od - 1])
 
 
-def _order_sc_sw(u, s, vt, h1, limit: int, dt: float, n: int, max_components: int, sc_tol: float) -> tuple[int, float, np.ndarray]:
+def _order_sc_sw(u, s, vt, p, limit: int, dt: float, n: int, max_components: int, sc_tol: float) -> tuple[int, float, np.ndarray]:
     """Paper 000's iterative order increase: od = 2, 4, … until SC_sw (eqs. 20-21) < sc_tol,
     the order limit, or one component more than ``max_components``."""
     od = min(2, limit)
@@ -289,7 +309,7 @@ def _order_sc_sw(u, s, vt, h1, limit: int, dt: float, n: int, max_components: in
     lam = np.zeros(0, complex)
     prev_od = od
     while True:
-        mu, gam = _poles_amplitudes(u, s, vt, h1, od)
+        mu, gam = _poles_amplitudes(u, s, vt, p, od)
         lam_od = _clean_poles(mu, dt, n)
         if count_components(lam_od) > max_components and len(lam):
             return prev_od, sc, lam  # one pair too many: keep the previous order
@@ -375,12 +395,13 @@ def decompose(x: np.ndarray, dt: float, *, max_components: int = 60, sc_tol: flo
         return empty
     limit = min(rank, max_order)
     xs = x / scale
+    p = _project(u, h1, vt)
     if stop == "residual":
         tol = max(sc_tol, noise_level(xs, dt, fmax)) if fmax else sc_tol
         od, sc = _order_from_energy(h0, s, limit, tol)
-        od, lam, gamma, sc = _best_order_near(xs, u, s, vt, h1, od, limit, dt, max_components, cutoff)
+        od, lam, gamma, sc = _best_order_near(xs, u, s, vt, p, od, limit, dt, max_components, cutoff)
     else:
-        od, sc, lam = _order_sc_sw(u, s, vt, h1, limit, dt, n, max_components, sc_tol)
+        od, sc, lam = _order_sc_sw(u, s, vt, p, limit, dt, n, max_components, sc_tol)
         gamma = _least_squares_amplitudes(xs, lam, dt)
     return Decomposition(lam, gamma * scale, t0, np.ones(len(lam), bool), od, sc)
 
@@ -414,7 +435,7 @@ def displacement_residual(r: np.ndarray, dt: float, cutoff: float | None) -> flo
     return float(np.sqrt(np.sum(np.abs(spec * w) ** 2) * 2) / len(r))
 
 
-def _best_order_near(xs, u, s, vt, h1, od0: int, limit: int, dt: float, max_components: int,
+def _best_order_near(xs, u, s, vt, p, od0: int, limit: int, dt: float, max_components: int,
                      cutoff: float | None, span: int = 4) -> tuple[int, np.ndarray, np.ndarray, float]:
     """Among the orders od0 − 2·span … od0 + 2·span, the one whose least-squares fit leaves the
     smallest :func:`displacement_residual`. A truncated SVD can produce a few spurious poles at
@@ -423,34 +444,89 @@ def _best_order_near(xs, u, s, vt, h1, od0: int, limit: int, dt: float, max_comp
     n = len(xs)
     best = None
     for od in sorted({min(max(2, od0 + 2 * j), limit) for j in range(-span, span + 1)}):
-        lam = _poles(u, s, vt, h1, od, dt, n)
+        lam = _poles(u, s, vt, p, od, dt, n)
         if count_components(lam) > max_components:
             continue
-        gamma = _least_squares_amplitudes(xs, lam, dt)
-        fit = np.real(np.exp(np.multiply.outer(np.arange(n) * dt, lam)) @ gamma) if len(lam) else 0.0
+        gamma, fit = _least_squares_amplitudes(xs, lam, dt, with_fit=True)
         score = displacement_residual(xs - fit, dt, cutoff)
         if best is None or score < best[3]:
             best = (od, lam, gamma, score)
     if best is None:
-        lam = _poles(u, s, vt, h1, 2, dt, n)
+        lam = _poles(u, s, vt, p, 2, dt, n)
         return 2, lam, _least_squares_amplitudes(xs, lam, dt), math.nan
     return best
 
 
-def _least_squares_amplitudes(x: np.ndarray, lam: np.ndarray, dt: float) -> np.ndarray:
+def exp_grid(lam: np.ndarray, dt: float, n: int, block: int = 64) -> np.ndarray:
+    """(n, M) matrix e^{λ_m k Δt}, k = 0 … n − 1, on a uniform grid.
+
+    Built as e^{λ(aB + b)Δt} = e^{λ aBΔt} · e^{λ bΔt} from two small tables (B = ``block``):
+    one complex multiplication per entry instead of one complex exponential, about 5× faster
+    and within a few ulp of ``np.exp``. Entries that overflow are inf, as with ``np.exp``."""
+    lam = np.asarray(lam, dtype=complex)
+    nb = -(-n // block)
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+        outer = np.exp(np.multiply.outer(np.arange(nb) * (block * dt), lam))  # (nb, M)
+        inner = np.exp(np.multiply.outer(np.arange(block) * dt, lam))  # (B, M)
+        v = (outer[:, None, :] * inner[None, :, :]).reshape(nb * block, len(lam))
+    return v[:n]
+
+
+def _least_squares_amplitudes(x: np.ndarray, lam: np.ndarray, dt: float, with_fit: bool = False):
     """γ minimising Σ_k |x_k − Σ γ_i e^{λ_i k Δt}|² (eq. 22 fitted to every sample).
 
-    The columns of the exponential (Vandermonde) matrix are normalised before the solve: a
-    slightly growing or fast-decaying pole makes column norms differ by many orders of
-    magnitude, and a rank-revealing solver would otherwise drop the small ones."""
-    t = np.arange(len(x)) * dt
-    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
-        v = np.exp(np.multiply.outer(t, lam))
-    if not np.all(np.isfinite(v)) or len(lam) == 0:
-        return np.zeros(len(lam), complex)
+    ``x`` is real and the poles of a real system matrix come in exact conjugate pairs, so the
+    fit is solved in real arithmetic: one column Re e^{λt} per real pole and two, Re and Im,
+    per pair (λ, λ̄), giving γ = (a − ib)/2 for λ and its conjugate for λ̄ — the unique complex
+    least-squares solution, at about a quarter of the cost. Poles without an exact partner fall
+    back to the complex solve. The columns are normalised before the solve: a slightly growing
+    or fast-decaying pole makes column norms differ by many orders of magnitude, and the
+    rank-revealing solver would otherwise drop the small ones. With ``with_fit``, also returns
+    the fitted signal (zeros if there are no poles)."""
+    n = len(x)
+    zero = np.zeros(len(lam), complex)
+    if len(lam) == 0:
+        return (zero, np.zeros(n)) if with_fit else zero
+    upper = lam.imag > 0
+    real = lam.imag == 0
+    partner = [np.nonzero(lam == np.conj(v))[0] for v in lam[upper]]
+    paired = all(len(j) == 1 for j in partner) and upper.sum() * 2 + real.sum() == len(lam)
+    if not paired:
+        return _complex_least_squares(x, lam, dt, with_fit)
+    basis_poles = np.concatenate((lam[upper], lam[real]))
+    e = exp_grid(basis_poles, dt, n)
+    if not np.all(np.isfinite(e)):
+        return (zero, np.zeros(n)) if with_fit else zero
+    m = int(upper.sum())
+    v = np.concatenate((e[:, :m].real, e[:, :m].imag, e[:, m:].real), axis=1)
     norms = np.linalg.norm(v, axis=0)
     norms[norms == 0] = 1.0
-    gamma, *_ = linalg.lstsq(v / norms, x.astype(complex), check_finite=False)
+    v /= norms
+    coef, *_ = linalg.lstsq(v, x, check_finite=False)
+    fit = v @ coef
+    coef /= norms
+    gamma = np.zeros(len(lam), complex)
+    g_up = 0.5 * (coef[:m] - 1j * coef[m:2 * m])
+    if m:
+        gamma[np.nonzero(upper)[0]] = g_up
+        gamma[np.concatenate(partner)] = np.conj(g_up)
+    gamma[np.nonzero(real)[0]] = coef[2 * m:]
+    return (gamma, fit) if with_fit else gamma
+
+
+def _complex_least_squares(x: np.ndarray, lam: np.ndarray, dt: float, with_fit: bool):
+    """Complex-arithmetic form of :func:`_least_squares_amplitudes` for poles not in exact
+    conjugate pairs; returns the real part of the fit."""
+    v = exp_grid(lam, dt, len(x))
+    if not np.all(np.isfinite(v)):
+        gamma = np.zeros(len(lam), complex)
+        return (gamma, np.zeros(len(x))) if with_fit else gamma
+    norms = np.linalg.norm(v, axis=0)
+    norms[norms == 0] = 1.0
+    v /= norms
+    gamma, *_ = linalg.lstsq(v, x.astype(complex), check_finite=False)
+    if with_fit:
+        return gamma / norms, np.real(v @ gamma)
     return gamma / norms
 
 
@@ -587,10 +663,10 @@ def reconstruct_displacement(acc: np.ndarray, dt: float, cutoff: float, *, max_c
             d.screen(cutoff, max_damping)
             decs[axis].append(d)
             tables.append(d.table(axis, j))
-            tt = t[s0:s1]
-            disp[s0:s1, axis] += w * d.evaluate(tt, 2)
-            vel[s0:s1, axis] += w * d.evaluate(tt, 1)
-            acc_fit[s0:s1, axis] += w * d.evaluate(tt, 0)
+            dva = d.evaluate_grid(t[s0], dt, s1 - s0) * w[:, None]
+            disp[s0:s1, axis] += dva[:, 0]
+            vel[s0:s1, axis] += dva[:, 1]
+            acc_fit[s0:s1, axis] += dva[:, 2]
     disp /= weights[:, None]
     vel /= weights[:, None]
     acc_fit /= weights[:, None]
