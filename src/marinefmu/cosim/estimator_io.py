@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..estimators.attitude import INIT_CHOICES, AttitudeParams
+from ..estimators.gnss_fusion import ANTENNAS, PROPAGATION_CHOICES, FusionParams
 from ..estimators.reconstruction import TILT_CHOICES
 from ..estimators.sliding_reconstruction import SlidingParams
 from ..interface import Variable, real, resolve, vec
@@ -89,4 +90,56 @@ def sliding_params(values: dict[str, Any]) -> SlidingParams:
         window=v["window"], hop=v["hop"], cutoff=v["cutoff"], max_components=v["max_components"],
         lever_arm=(v["lever_arm.x"], v["lever_arm.y"], v["lever_arm.z"]), fmax=v["fmax"], tilt=v["tilt"],
         max_damping=v["max_damping"], sc_tol=v["sc_tol"],
+    )
+
+
+_FU = FusionParams()
+FUSION_PARAMETERS: list[Variable] = [
+    *[v for i, arm in enumerate(_FU.antennas) for v in vec(f"ant{i + 1}", "xyz", arm, "m", f"GNSS antenna {i + 1} lever arm relative to the COG, body frame")],
+    *vec("acc_lever_arm", "xyz", 0.0, "m", "Accelerometer position relative to the COG, body frame"),
+    real("q", _FU.q, "m2/s3", "Acceleration process-noise density (paper 001 eq. 16), > 0"),
+    real("r", _FU.r, "m2*s", "GNSS position noise, R = r/dt (paper 001 eq. 17), > 0"),
+    Variable("attitude_correction", "boolean", True, "", "Rotate the specific force with the attitude (false: the paper's uncorrected case)"),
+    Variable("propagation", "string", _FU.propagation, "", f"Attitude between GNSS epochs: one of {', '.join(PROPAGATION_CHOICES)} (gyro needs gyro.* inputs)"),
+    real("attitude_tau", _FU.attitude_tau, "s", "Time constant of the PI attitude correction, 0.1..1000"),
+    real("gate", _FU.gate, "", "Mahalanobis innovation gate in standard deviations, > 0"),
+    Variable("bias_states", "boolean", True, "", "Estimate an accelerometer bias per NED axis"),
+    real("bias_rw", _FU.bias_rw, "m/s2/sqrt(s)", "Random-walk density of the bias states, (0, 10]"),
+    real("max_residual", _FU.max_residual, "m", "Largest RMS antenna-fit residual of a usable fix, > 0"),
+    real("reinit_time", _FU.reinit_time, "s", "Re-initialise on GNSS after rejecting fixes this long, > 0"),
+    real("max_coast", _FU.max_coast, "s", "valid goes false this long after the last accepted fix, > 0"),
+]
+FUSION_INPUTS: list[Variable] = [
+    *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),
+    *vec("gyro", "xyz", 0.0, "rad/s", "Angular rate, body frame (for propagation = gyro)"),
+    *[v for i in range(ANTENNAS) for v in vec(f"gnss.ant{i + 1}", "ned", 0.0, "m", f"Measured position of GNSS antenna {i + 1}, NED")],
+    Variable("gnss.valid", "boolean", False, "", "True when the antenna positions hold a valid fix"),
+    Variable("gnss.new", "boolean", False, "", "True on the step a new fix arrived (if unconnected, a change of the positions marks a new fix)"),
+]
+FUSION_OUTPUTS: list[Variable] = [
+    *vec("pos", "ned", 0.0, "m", "Fused COG position, NED"),
+    *vec("vel", "ned", 0.0, "m/s", "Fused COG velocity, NED"),
+    *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (filter covariance), NED"),
+    real("roll", 0.0, "rad", "Roll used for the correction (antennas, gyro-propagated)"),
+    real("pitch", 0.0, "rad", "Pitch used for the correction"),
+    real("yaw", 0.0, "rad", "Yaw used for the correction"),
+    *vec("acc_n", "ned", 0.0, "m/s2", "Attitude-corrected acceleration at the accelerometer, NED"),
+    *vec("acc_bias", "ned", 0.0, "m/s2", "Estimated accelerometer bias, NED"),
+    real("gnss.residual", 0.0, "m", "RMS antenna-fit residual of the latest fix"),
+]
+FUSION_BOOLEANS: list[Variable] = [
+    Variable("valid", "boolean", False, "", "Initialised, good sample, and an accepted GNSS fix within max_coast"),
+    Variable("gnss.accepted", "boolean", False, "", "True on the step a GNSS fix was accepted"),
+]
+
+
+def fusion_params(values: dict[str, Any]) -> FusionParams:
+    """FusionParams from FMI-named values."""
+    v = resolve(FUSION_PARAMETERS, values, "GnssAccFusion")
+    xyz = lambda prefix: tuple(v[f"{prefix}.{a}"] for a in "xyz")  # noqa: E731
+    return FusionParams(
+        antennas=tuple(xyz(f"ant{i + 1}") for i in range(ANTENNAS)), acc_lever_arm=xyz("acc_lever_arm"),
+        q=v["q"], r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
+        attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
+        max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
     )

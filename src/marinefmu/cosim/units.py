@@ -24,6 +24,9 @@ UNITS: dict[str, dict[str, int]] = {
     "rad/s/sqrt(Hz)": {},
     "m2": {"m": 2},
     "rad2": {"rad": 2},
+    "m2/s3": {"m": 2, "s": -3},
+    "m2*s": {"m": 2, "s": 1},
+    "m/s2/sqrt(s)": {},
 }
 _ORDER = ("ModelExchange", "CoSimulation", "UnitDefinitions", "TypeDefinitions", "LogCategories",
           "DefaultExperiment", "VendorAnnotations", "ModelVariables", "ModelStructure")

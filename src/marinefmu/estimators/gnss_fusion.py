@@ -136,7 +136,8 @@ class FusionParams:
         check_range("r", self.r, lo=0.0, lo_open=True, hi=1e6, unit="m2*s")
         check_choice("propagation", self.propagation, PROPAGATION_CHOICES)
         check_range("attitude_tau", self.attitude_tau, lo=0.1, hi=1000.0, unit="s")
-        check_range("gate", self.gate, lo=0.0, lo_open=True, hi=math.inf, unit="sigma")
+        if self.gate != math.inf:  # inf: no gating (the paper)
+            check_range("gate", self.gate, lo=0.0, lo_open=True, unit="sigma")
         check_range("bias_rw", self.bias_rw, lo=0.0, lo_open=True, hi=10.0, unit="m/s2/sqrt(s)")
         check_range("max_residual", self.max_residual, lo=0.0, lo_open=True, unit="m")
         check_range("reinit_time", self.reinit_time, lo=0.0, lo_open=True, unit="s")
@@ -203,7 +204,7 @@ class FusionResult:
     pos, vel : tuple of float
         COG position [m] and velocity [m/s], NED.
     pos_std : tuple of float
-        1σ of the fused position (filter covariance) [m].
+        1σ of the fused position (filter covariance) [m]; 0 before initialisation.
     euler : tuple of float
         Roll, pitch, yaw [rad] used for the correction.
     acc_n : tuple of float
@@ -211,7 +212,7 @@ class FusionResult:
     acc_bias : tuple of float
         Estimated n-frame accelerometer bias [m/s²] (zeros without bias states).
     residual : float
-        RMS antenna-fit residual of the latest fix [m] (NaN before the first).
+        RMS antenna-fit residual of the latest usable fix [m] (0 before the first).
     fix : str
         What happened to a GNSS epoch this step: "", "accepted", "rejected", "skipped".
     valid : bool
@@ -292,7 +293,7 @@ class GnssAccFusion:
         self.since_epoch = 0.0  # time since the last GNSS epoch of any kind [s]
         self.rejecting = 0.0  # time spent rejecting consecutive fixes [s]
         self.prior: tuple[np.ndarray, np.ndarray] | None = None  # (x⁻, P⁻) of this step, for smoothing
-        self.residual = math.nan
+        self.residual = 0.0
         self.acc_n = np.zeros(3)
 
     # ---- per step ----------------------------------------------------------------------------
@@ -416,7 +417,7 @@ class GnssAccFusion:
         vel = x[3:6].copy()
         if w is not None and self.initialised:
             vel -= rot @ np.cross(w - self.gyro_bias, p.acc_lever_arm)
-        std = np.sqrt(np.diag(self.kf.P)[:3]) if self.initialised else np.full(3, math.nan)
+        std = np.sqrt(np.diag(self.kf.P)[:3]) if self.initialised else np.zeros(3)  # valid is False then
         bias = x[6:9] if p.bias_states else np.zeros(3)
         euler = quat_to_euler(self.q)
         return FusionResult(tuple(pos.tolist()), tuple(vel.tolist()), tuple(std.tolist()), tuple(euler),

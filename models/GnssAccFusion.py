@@ -1,0 +1,57 @@
+"""GnssAccFusion FMU: four-antenna GNSS attitude corrects the accelerometer, and a multirate
+Kalman filter fuses it with the GNSS position (paper 001). Thin adapter over
+``marinefmu.estimators.gnss_fusion``; never raises (see ``marinefmu.cosim.slave``)."""
+import numpy as np
+from pythonfmu import Fmi2Slave
+
+from marinefmu import __version__
+from marinefmu.cosim.estimator_io import (
+    FUSION_BOOLEANS, FUSION_INPUTS, FUSION_OUTPUTS, FUSION_PARAMETERS, fusion_params,
+)
+from marinefmu.cosim.slave import SlaveIO
+from marinefmu.estimators.gnss_fusion import GnssAccFusion as Estimator
+
+ANT_NAMES = [f"gnss.ant{i}.{a}" for i in range(1, 5) for a in "ned"]
+
+
+class GnssAccFusion(Fmi2Slave):
+    author = "marinefmu developers"
+    description = "Multi-antenna GNSS + accelerometer Kalman fusion with attitude correction (paper 001)"
+    version = __version__
+    license = "MIT"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.io = SlaveIO(self, FUSION_PARAMETERS, FUSION_OUTPUTS, FUSION_BOOLEANS, FUSION_INPUTS)
+        self.model = None
+        self.last_fix = None
+
+    def setup_experiment(self, start_time, stop_time, tolerance):
+        self.io.start_time = start_time
+
+    def exit_initialization_mode(self):
+        self.model = self.io.build(lambda values: Estimator(fusion_params(values)))
+
+    def do_step(self, current_time, step_size):
+        return self.io.step(lambda: self._step(current_time + step_size, step_size))
+
+    def _step(self, t, dt):
+        i = self.io.inputs
+        ant = [i[n] for n in ANT_NAMES]
+        new = i["gnss.valid"] and (i["gnss.new"] or ant != self.last_fix)
+        if new:
+            self.last_fix = ant
+        r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), np.array(ant) if new else None, dt,
+                            (i["gyro.x"], i["gyro.y"], i["gyro.z"]))
+        self.io.warn(r.warning, t)
+        self.io.set_outputs([*r.pos, *r.vel, *r.pos_std, *r.euler, *r.acc_n, *r.acc_bias, r.residual],
+                            [r.valid, r.fix == "accepted"])
+
+    def _get_fmu_state(self):
+        state = self.io.get_state(self.model)
+        state["last_fix"] = self.last_fix
+        return state
+
+    def _set_fmu_state(self, state):
+        self.last_fix = state.get("last_fix")
+        self.io.set_state(self.model, state)
