@@ -25,6 +25,7 @@ class GnssAccFusion(Fmi2Slave):
         self.io = SlaveIO(self, FUSION_PARAMETERS, FUSION_OUTPUTS, FUSION_BOOLEANS, FUSION_INPUTS)
         self.model = None
         self.last_fix = None
+        self.new_connected = False  # gnss.new has been seen true: rely on it, not on changes
 
     def setup_experiment(self, start_time, stop_time, tolerance):
         self.io.start_time = start_time
@@ -38,7 +39,8 @@ class GnssAccFusion(Fmi2Slave):
     def _step(self, t, dt):
         i = self.io.inputs
         ant = [i[n] for n in ANT_NAMES]
-        new = i["gnss.valid"] and (i["gnss.new"] or ant != self.last_fix)
+        self.new_connected = self.new_connected or i["gnss.new"]
+        new = i["gnss.valid"] and (i["gnss.new"] if self.new_connected else ant != self.last_fix)
         if new:
             self.last_fix = ant
         r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), np.array(ant) if new else None, dt,
@@ -49,9 +51,9 @@ class GnssAccFusion(Fmi2Slave):
 
     def _get_fmu_state(self):
         state = self.io.get_state(self.model)
-        state["last_fix"] = self.last_fix
+        state["last_fix"], state["new_connected"] = self.last_fix, self.new_connected
         return state
 
     def _set_fmu_state(self, state):
-        self.last_fix = state.get("last_fix")
+        self.last_fix, self.new_connected = state.get("last_fix"), state.get("new_connected", False)
         self.io.set_state(self.model, state)

@@ -1,7 +1,9 @@
-"""AttitudeEstimator and DisplacementReconstructor FMUs run by FMPy equal the in-process
+"""AttitudeEstimator and DisplacementReconstructor FMUs (and GnssAccFusion's validation and
+parameter refusal) run by FMPy equal the in-process
 estimators bit for bit, refuse bad parameters by name, and coast over a NaN input."""
 import numpy as np
 import pytest
+from conftest import Driver
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
@@ -14,40 +16,13 @@ from marinefmu.examples import paper000_semisub
 DT = 0.01
 
 
-class Driver:
-    def __init__(self, path, tmp, name):
-        self.md = read_model_description(str(path))
-        self.vr = {v.name: v for v in self.md.modelVariables}
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=extract(str(path), unzipdir=str(tmp / name)),
-                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
-        self.fmu.instantiate()
-
-    def init(self, params):
-        self.fmu.setupExperiment(startTime=0.0)
-        for k, v in params.items():
-            setter = {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger, "String": self.fmu.setString}
-            setter[self.vr[k].type]([self.vr[k].valueReference], [v])
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
-
-    def step(self, k, inputs, outputs, booleans=("valid",)):
-        self.fmu.setReal([self.vr[n].valueReference for n in inputs], list(inputs.values()))
-        status = self.fmu.doStep(currentCommunicationPoint=k * DT, communicationStepSize=DT)
-        reals = self.fmu.getReal([self.vr[n].valueReference for n in outputs])
-        return status, reals, self.fmu.getBoolean([self.vr[n].valueReference for n in booleans])
-
-    def close(self):
-        self.fmu.terminate()
-        self.fmu.freeInstance()
-
-
 @pytest.fixture(scope="module")
 def record():
     return paper000_semisub.simulate(80.0, noise=True)
 
 
 @pytest.mark.fmu
-@pytest.mark.parametrize("name", ["AttitudeEstimator", "DisplacementReconstructor"])
+@pytest.mark.parametrize("name", ["AttitudeEstimator", "DisplacementReconstructor", "GnssAccFusion"])
 def test_validate(fmu_dir, name):
     assert validate_fmu(str(fmu_dir / f"{name}.fmu")) == []
 
@@ -94,6 +69,9 @@ def test_reconstructor_fmu_equals_in_process(fmu_dir, tmp_path, record):
     ("AttitudeEstimator", {"vel_sigma": -1.0}, "vel_sigma = -1.0 is out of range"),
     ("DisplacementReconstructor", {"window": 10.0}, "window = 10.0 is out of range"),
     ("DisplacementReconstructor", {"max_components": 0}, "max_components = 0 is out of range"),
+    ("GnssAccFusion", {"gate": 0.0}, "gate = 0.0 is out of range"),
+    ("GnssAccFusion", {"q": -1.0}, "q = -1.0 is out of range"),
+    ("GnssAccFusion", {"r": 0.0}, "r = 0.0 is out of range"),
 ])
 def test_bad_parameters_are_logged_and_steps_discarded(fmu_dir, tmp_path, name, params, message):
     from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
