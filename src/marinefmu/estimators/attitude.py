@@ -52,12 +52,10 @@ from filterpy.kalman import KalmanFilter
 
 from ..errors import check_choice, check_int, check_range, check_vector
 from ..frames import euler_to_quat, level_angles, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
+from .samples import force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
 
-#: Largest angular rate [rad/s] and specific force [m/s²] accepted as a physical sample.
-MAX_RATE = 10.0
-MAX_SPECIFIC_FORCE = 200.0
 INIT_CHOICES = ("given", "level")
 
 
@@ -187,11 +185,7 @@ def integrate_gyro_euler(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndar
 def _bad_sample(gyro: np.ndarray, acc: np.ndarray) -> str | None:
     if not (np.all(np.isfinite(gyro)) and np.all(np.isfinite(acc))):
         return "non-finite gyro or acc sample"
-    if np.max(np.abs(gyro)) > MAX_RATE:
-        return f"gyro sample beyond ±{MAX_RATE} rad/s"
-    if math.sqrt(acc @ acc) > MAX_SPECIFIC_FORCE:
-        return f"specific force beyond {MAX_SPECIFIC_FORCE} m/s²"
-    return None
+    return rate_beyond_limit(gyro) or force_beyond_limit(acc)
 
 
 class AttitudeEstimator:

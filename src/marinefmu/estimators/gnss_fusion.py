@@ -49,6 +49,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError, ShapeError, check_choice, check_range, check_vector
 from ..frames import GRAVITY_N, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
+from .samples import force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
 
@@ -56,9 +57,6 @@ ANTENNAS = 4
 PROPAGATION_CHOICES = ("gyro", "hold")
 #: Default antenna lever arms [m] (body frame, relative to the COG): VesselMotion's defaults.
 DEFAULT_ANTENNAS = ((10.0, -4.0, -10.0), (10.0, 4.0, -10.0), (-10.0, -4.0, -10.0), (-10.0, 4.0, -10.0))
-#: Largest specific force [m/s²] and rate [rad/s] accepted as physical samples.
-MAX_SPECIFIC_FORCE = 200.0
-MAX_RATE = 10.0
 #: Smallest second singular value [m] of the centred antenna positions (they must span a plane).
 MIN_SPREAD = 0.05
 
@@ -237,10 +235,9 @@ def transition(dt: float, bias: bool) -> tuple[np.ndarray, np.ndarray]:
     """Φ and G of the constant-acceleration model (eq. 15) for the 3 axes, state
     [d_n, d_e, d_d, v_n, v_e, v_d (, b_n, b_e, b_d)], input a_n (bias subtracted)."""
     i3 = np.eye(3)
-    blocks = [[i3, dt * i3], [0 * i3, i3]]
     g = np.vstack((0.5 * dt * dt * i3, dt * i3))
     if not bias:
-        return np.block(blocks), g
+        return np.block([[i3, dt * i3], [0 * i3, i3]]), g
     f = np.block([[i3, dt * i3, -0.5 * dt * dt * i3], [0 * i3, i3, -dt * i3], [0 * i3, 0 * i3, i3]])
     return f, np.vstack((g, 0 * i3))
 
@@ -293,6 +290,7 @@ class GnssAccFusion:
         self.since_epoch = 0.0  # time since the last GNSS epoch of any kind [s]
         self.rejecting = 0.0  # time spent rejecting consecutive fixes [s]
         self.prior: tuple[np.ndarray, np.ndarray] | None = None  # (x⁻, P⁻) of this step, for smoothing
+        self._model_dt: float | None = None  # Φ, G, Q below are built for this step size
         self.residual = 0.0
         self.acc_n = np.zeros(3)
 
@@ -315,13 +313,13 @@ class GnssAccFusion:
         p = self.params
         warning = None
         f_b = np.asarray(acc, dtype=float).reshape(3)
-        good = bool(np.all(np.isfinite(f_b)) and math.sqrt(f_b @ f_b) <= MAX_SPECIFIC_FORCE)
+        good = bool(np.all(np.isfinite(f_b))) and force_beyond_limit(f_b) is None
         if not good:
             warning = "bad accelerometer sample (NaN/Inf/absurd): coasting on the last good one"
             f_b = self.last_acc
         self.last_acc = f_b
         w = None if gyro is None else np.asarray(gyro, dtype=float).reshape(3)
-        if w is not None and not (np.all(np.isfinite(w)) and np.max(np.abs(w)) <= MAX_RATE):
+        if w is not None and not (np.all(np.isfinite(w)) and rate_beyond_limit(w) is None):
             warning = warning or "bad gyro sample (NaN/Inf/absurd): holding the last good rate"
             good = False
             w = self.last_gyro
@@ -336,9 +334,10 @@ class GnssAccFusion:
         self.since_epoch += dt
         self.prior = None
         if self.initialised:
-            f, g = transition(dt, p.bias_states)
-            self.kf.F, self.kf.B = f, g
-            self.kf.Q = process_noise(dt, p.q, p.bias_rw if p.bias_states else None)
+            if dt != self._model_dt:  # rebuilt only when the step size changes
+                self.kf.F, self.kf.B = transition(dt, p.bias_states)
+                self.kf.Q = process_noise(dt, p.q, p.bias_rw if p.bias_states else None)
+                self._model_dt = dt
             self.kf.predict(u=self.acc_n.reshape(3, 1))
             self.prior = (self.kf.x.copy(), self.kf.P.copy())
         fix = ""

@@ -27,13 +27,13 @@ import numpy as np
 
 from ..errors import check_choice, check_range, check_vector
 from ..frames import G, rot_nb
+from .samples import force_beyond_limit
 from .reconstruction import (
     TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, lowpass_decimate,
     tilt_correct,
 )
 
 log = logging.getLogger(__name__)
-MAX_SPECIFIC_FORCE = 200.0
 MAX_TILT = math.radians(80.0)
 
 
@@ -267,8 +267,9 @@ def _check_sample(acc: np.ndarray, euler: np.ndarray) -> str | None:
         return "sample of the wrong shape"
     if not (np.all(np.isfinite(acc)) and np.all(np.isfinite(euler))):
         return "non-finite acc or attitude sample"
-    if math.sqrt(acc @ acc) > MAX_SPECIFIC_FORCE:
-        return f"specific force beyond {MAX_SPECIFIC_FORCE} m/s²"
+    too_big = force_beyond_limit(acc)
+    if too_big:
+        return too_big
     if abs(euler[0]) > MAX_TILT or abs(euler[1]) > MAX_TILT:
         return "roll or pitch beyond ±80°"
     return None

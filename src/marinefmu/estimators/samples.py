@@ -1,0 +1,21 @@
+"""Plausibility limits for single IMU samples, shared by the estimators: a sample beyond them
+is a sensor fault (the estimator coasts on its last good sample, see each ``step``)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: Largest angular rate [rad/s] and specific force [m/s²] accepted as a physical sample.
+MAX_RATE = 10.0
+MAX_SPECIFIC_FORCE = 200.0
+
+
+def force_beyond_limit(acc: np.ndarray) -> str | None:
+    """Reason if the finite specific force ``acc`` [m/s²] exceeds :data:`MAX_SPECIFIC_FORCE`."""
+    return f"specific force beyond {MAX_SPECIFIC_FORCE} m/s²" if math.sqrt(acc @ acc) > MAX_SPECIFIC_FORCE else None
+
+
+def rate_beyond_limit(gyro: np.ndarray) -> str | None:
+    """Reason if a component of the finite rate ``gyro`` [rad/s] exceeds :data:`MAX_RATE`."""
+    return f"gyro sample beyond ±{MAX_RATE} rad/s" if np.max(np.abs(gyro)) > MAX_RATE else None
