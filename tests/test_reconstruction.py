@@ -96,6 +96,8 @@ def test_semisub_6dof_goals(noise, bounds):
     assert np.all(r["cog_rms_pct"] <= bounds), r["cog_rms_pct"]
     if not noise:
         assert np.all(r["attitude_rms_deg"][:2] < 0.001)  # gyro-only, noise-free: paper's setting
+    else:  # the goal, aided filter + post-processed refinement (measured 0.0061/0.0070)
+        assert np.all(r["attitude_rms_deg"][:2] <= 0.02), r["attitude_rms_deg"]
 
 
 def test_tilt_correction_small_angle_matches_exact_to_second_order():
