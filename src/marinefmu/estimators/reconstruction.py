@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg, signal
+from threadpoolctl import ThreadpoolController
 
 from ..errors import ParameterError, ShapeError, check_choice, check_int, check_range
 from ..frames import G
@@ -221,6 +222,24 @@ class Decomposition:
         return np.sort(out, order="frequency")
 
 
+_BLAS: ThreadpoolController | None = None
+
+
+def one_blas_thread():
+    """Context manager that runs BLAS/LAPACK on one thread (threadpoolctl), restoring the
+    previous setting on exit.
+
+    The decomposition's matrices are small (≈ 500 × 500 SVDs, 1000 × 120 least squares), and
+    OpenBLAS's thread synchronisation costs more than it gains on them: measured 2026-11-22
+    on this project's 2-core machine, one hour of 100 Hz three-axis acceleration took 14.9 s
+    with OpenBLAS's default two threads and 6.7 s with one (same results to 1e-12 m).
+    Running (segment, axis) fits in parallel Python threads instead gained nothing (7.7 s)."""
+    global _BLAS
+    if _BLAS is None:
+        _BLAS = ThreadpoolController()
+    return _BLAS.limit(limits=1, user_api="blas")
+
+
 def hankel_pair(x: np.ndarray, rows: int) -> tuple[np.ndarray, np.ndarray]:
     """H(0) and H(1) of eq. 17 with ``rows`` rows and N − rows columns (all samples used)."""
     n = len(x)
@@ -378,7 +397,12 @@ def decompose(x: np.ndarray, dt: float, *, max_components: int = 60, sc_tol: flo
         Empty (no components) for a signal that is all zero or too short (N < 4).
     """
     check_choice("stop", stop, STOP_CHOICES)
-    x = np.asarray(x, dtype=float)
+    with one_blas_thread():
+        return _decompose(np.asarray(x, dtype=float), dt, max_components, sc_tol, stop, rows, t0, cutoff, fmax, rng)
+
+
+def _decompose(x: np.ndarray, dt: float, max_components: int, sc_tol: float, stop: str, rows: int | None,
+               t0: float, cutoff: float | None, fmax: float | None, rng: np.random.Generator | None) -> Decomposition:
     n = len(x)
     scale = float(np.max(np.abs(x))) if n else 0.0
     empty = Decomposition(np.zeros(0, complex), np.zeros(0, complex), t0, np.zeros(0, bool), 0, math.nan)
