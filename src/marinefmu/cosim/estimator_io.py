@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..estimators.attitude import INIT_CHOICES, AttitudeParams
-from ..estimators.gnss_fusion import ANTENNAS, PROPAGATION_CHOICES, FusionParams
+from ..estimators.gnss_fusion import ANTENNAS, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
 from ..estimators.reconstruction import TILT_CHOICES
 from ..estimators.sliding_reconstruction import SlidingParams
 from ..interface import Variable, real, resolve, vec
@@ -101,6 +101,7 @@ FUSION_PARAMETERS: list[Variable] = [
     real("r", _FU.r, "m2*s", "GNSS position noise, R = r/dt (paper 001 eq. 17), > 0"),
     Variable("attitude_correction", "boolean", True, "", "Rotate the specific force with the attitude (false: the paper's uncorrected case)"),
     Variable("propagation", "string", _FU.propagation, "", f"Attitude between GNSS epochs: one of {', '.join(PROPAGATION_CHOICES)} (gyro needs gyro.* inputs)"),
+    Variable("step_input", "string", _FU.step_input, "", f"Acceleration and rate over a step: one of {', '.join(STEP_INPUT_CHOICES)} (mean of the two bounding samples, or the latest held as the paper)"),
     real("attitude_tau", _FU.attitude_tau, "s", "Time constant of the PI attitude correction, 0.1..1000"),
     real("gate", _FU.gate, "", "Mahalanobis innovation gate in standard deviations, > 0"),
     Variable("bias_states", "boolean", True, "", "Estimate an accelerometer bias per NED axis"),
@@ -140,6 +141,6 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
     return FusionParams(
         antennas=tuple(xyz(f"ant{i + 1}") for i in range(ANTENNAS)), acc_lever_arm=xyz("acc_lever_arm"),
         q=v["q"], r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
-        attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
+        step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
     )
