@@ -146,8 +146,17 @@ def test_tilting_case_goals(tilting_record):
 
 
 def test_horizontal_case_at_1_hz():
-    r = paper001.horizontal(rates=(1.0,), duration=240.0)[1.0]
+    """Experiment (a), 1 Hz GNSS: fused error <= half the raw GNSS error, and the fused
+    spectrum matches the truth's across the motion band (where the truth's PSD is >= 1 % of
+    its peak) within 0.5 dB on the axes that move (sway, heave; surge is still in beam
+    seas), and at least twice as closely as the raw GNSS held between epochs. Measured over
+    this 240 s run: fused 0.29 / 0.10 dB, raw 0.97 / 0.57 dB (600 s: fused 0.08 / 0.03 dB)."""
+    r = paper001.horizontal(rates=(1.0,), duration=240.0, records=True)[1.0]
     assert np.linalg.norm(r["fused"]) <= 0.5 * np.linalg.norm(r["gnss"]), r
+    assert np.isnan(r["spectrum_db"][0]) and np.all(r["spectrum_db"][1:] < 0.5), r["spectrum_db"]
+    s = slice(int(60.0 / paper001.DT), None)
+    raw_db = paper001.spectrum_deviation_db(r["gnss_pos"][s], r["truth"][s], paper001.DT)
+    assert np.all(2 * r["spectrum_db"][1:] < raw_db[1:]), (r["spectrum_db"], raw_db)
 
 
 def test_a_20_m_jump_is_gated_out():

@@ -8,6 +8,8 @@ Examples
     marinefmu simulate default --duration 120 --out results/default
     marinefmu simulate my_scenario.toml
     marinefmu bench
+    marinefmu example --list
+    marinefmu example paper001-fig7 --out results/examples
 """
 from __future__ import annotations
 
@@ -74,6 +76,30 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_example(args: argparse.Namespace) -> int:
+    from .examples.registry import EXAMPLES, format_value
+
+    if args.list or not args.name:
+        for name, (text, _) in EXAMPLES.items():
+            print(f"  {name:24s} {text}")
+        return 0
+    if args.name not in EXAMPLES:
+        print(f"marinefmu: error: unknown example {args.name!r}; one of: {', '.join(EXAMPLES)}", file=sys.stderr)
+        return 2
+    text, run = EXAMPLES[args.name]
+    out = Path(args.out)
+    print(f"{args.name}: {text}")
+    t0 = time.perf_counter()
+    figures = run(out)
+    for key, value in figures.items():
+        print(f"  {key:40s} {format_value(value)}")
+    pngs = sorted(out.glob("*.png")) if out.is_dir() else []
+    for png in pngs:
+        print(f"  plot {png}")
+    print(f"  ({time.perf_counter() - t0:.0f} s)")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``marinefmu`` console script."""
     parser = argparse.ArgumentParser(prog="marinefmu", description="Marine motion estimation FMUs: build, simulate, benchmark.")
@@ -93,6 +119,11 @@ def main(argv: list[str] | None = None) -> int:
     k.add_argument("--out", default="bench", help="output folder for bench.json (default bench/)")
     k.add_argument("--steps", type=int, default=60000, help="FMU steps per measurement (default 60000)")
     k.set_defaults(func=_cmd_bench)
+    e = sub.add_parser("example", help="run one of the papers' examples (list them with --list)")
+    e.add_argument("name", nargs="?", help="example name, e.g. paper001-fig7")
+    e.add_argument("--list", action="store_true", help="list the examples")
+    e.add_argument("--out", default="results/examples", help="folder for plots (default results/examples)")
+    e.set_defaults(func=_cmd_example)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:

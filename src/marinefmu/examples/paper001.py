@@ -21,6 +21,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from scipy import signal
 
 from ..estimators.gnss_fusion import FusionParams, fuse
 from ..sea.motion_model import REAL_INDEX, VesselMotionModel, VesselMotionParams
@@ -88,20 +89,109 @@ def params(**kw) -> FusionParams:
     return replace(FusionParams(antennas=ANT, acc_lever_arm=IMU), **kw)
 
 
-def horizontal(rates=(10.0, 5.0, 2.0, 1.0), duration: float = 600.0, settle: float = 60.0) -> dict:
-    """Experiment (a): translation-only hull, GNSS at each rate; RMS errors of fused and raw GNSS."""
+def horizontal(rates=(10.0, 5.0, 2.0, 1.0), duration: float = 600.0, settle: float = 60.0,
+               records: bool = False, out: str | Path | None = None) -> dict:
+    """Experiment (a): translation-only hull, GNSS at each rate; RMS errors of fused and raw GNSS.
+
+    Returns, per rate, ``fused`` and ``gnss`` RMS errors [m] per axis and ``spectrum_db``, the
+    largest deviation of the fused position's spectrum from the truth's within the motion
+    band (:func:`spectrum_deviation_db`) per axis. With ``records`` also the time series
+    (``time``, ``fused_pos``, ``gnss_pos``, ``truth``); with ``out`` a plot in the style of
+    the paper's Fig. 7 is written there (``paper001_fig7.png``).
+    """
     with tempfile.TemporaryDirectory() as tmp:
         table = preset_raos("polar_supply")
         rao = table.rao.copy()
         rao[3:] = 0.0
         path = Path(tmp) / "translation_only.csv"
         save_rao_csv(replace(table, rao=rao, name="translation only"), path)
-        out = {}
+        result = {}
         for rate in rates:
             rec = simulate(duration, {"vessel.rao_file": str(path), "gnss.rate": rate})
             r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params())
-            out[rate] = {"fused": rms(r["pos"], rec["cog"], settle), "gnss": rms(raw_gnss_cog(rec), rec["cog"], settle)}
+            raw = raw_gnss_cog(rec)
+            s = slice(int(settle / DT), None)
+            result[rate] = {"fused": rms(r["pos"], rec["cog"], settle), "gnss": rms(raw, rec["cog"], settle),
+                            "spectrum_db": spectrum_deviation_db(r["pos"][s], rec["cog"][s], DT)}
+            if records or out is not None:
+                result[rate].update(time=(np.arange(len(raw)) + 1) * DT, fused_pos=r["pos"], gnss_pos=raw,
+                                    truth=rec["cog"])
+    if out is not None:
+        _plot_fig7(result, Path(out), settle)
+    return result
+
+
+#: Motion band of :func:`spectrum_deviation_db`: frequencies where the truth's spectrum holds
+#: at least this fraction of its peak.
+BAND_FRACTION = 0.01
+
+
+def welch_psd(x: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided Welch PSD of each column [unit²/Hz] (scipy, Hann, 8192-sample segments,
+    linear detrend): frequencies (F,) [Hz] and PSD (F, k)."""
+    return signal.welch(x, fs=1.0 / dt, nperseg=min(len(x), 8192), detrend="linear", axis=0)
+
+
+def spectrum_deviation_db(est: np.ndarray, truth: np.ndarray, dt: float, min_std: float = 1e-3) -> np.ndarray:
+    """Largest |10 log10 (PSD_est / PSD_truth)| [dB] per axis over the motion band (the
+    frequencies where the truth's PSD is at least :data:`BAND_FRACTION` of its peak);
+    NaN for an axis whose truth moves less than ``min_std`` [m] (standard deviation)."""
+    f, p_est = welch_psd(est, dt)
+    _, p_true = welch_psd(truth, dt)
+    out = np.full(p_true.shape[1], np.nan)
+    for i in range(p_true.shape[1]):
+        peak = p_true[:, i].max()
+        band = p_true[:, i] >= BAND_FRACTION * peak
+        if np.std(truth[:, i]) >= min_std and band.any():
+            out[i] = np.max(np.abs(10.0 * np.log10(p_est[band, i] / p_true[band, i])))
     return out
+
+
+def _plot_fig7(result: dict, out: Path, settle: float) -> None:
+    """Paper 001 Fig. 7 re-created: sway time series (truth, GNSS held, fused) for each GNSS
+    rate and the spectra of fused and raw GNSS against the truth."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out.mkdir(parents=True, exist_ok=True)
+    rates = list(result)
+    fig, ax = plt.subplots(len(rates), 2, figsize=(12, 2.6 * len(rates)), squeeze=False)
+    for row, rate in enumerate(rates):
+        r = result[rate]
+        t = r["time"]
+        w = (t >= settle) & (t < settle + 30.0)
+        a = ax[row, 0]
+        a.plot(t[w], r["truth"][w, 1], "k", lw=1.5, label="truth")
+        a.plot(t[w], r["gnss_pos"][w, 1], color="tab:orange", lw=1, label=f"GNSS {rate:g} Hz (held)")
+        a.plot(t[w], r["fused_pos"][w, 1], "--", color="tab:blue", lw=1, label="fused with 100 Hz acc")
+        a.set_ylabel("sway (east) [m]")
+        a.set_title(f"{rate:g} Hz GNSS: RMS error fused {100 * r['fused'][1]:.2f} cm, GNSS {100 * r['gnss'][1]:.2f} cm",
+                    fontsize=9)
+        a.legend(loc="upper right", fontsize=7)
+        a.grid(alpha=0.3)
+        s = t >= settle
+        good = s & np.all(np.isfinite(r["gnss_pos"]), axis=1)
+        f, p_true = welch_psd(r["truth"][s, 1:2], DT)
+        _, p_fused = welch_psd(r["fused_pos"][s, 1:2], DT)
+        f_g, p_gnss = welch_psd(r["gnss_pos"][good, 1:2], DT)
+        b = ax[row, 1]
+        b.semilogy(f, p_true[:, 0], "k", lw=1.5, label="truth")
+        b.semilogy(f_g, p_gnss[:, 0], color="tab:orange", lw=1, label="GNSS (held)")
+        b.semilogy(f, p_fused[:, 0], "--", color="tab:blue", lw=1,
+                   label=f"fused (band deviation {r['spectrum_db'][1]:.2f} dB)")
+        b.set_xlim(0.0, 2.0)
+        b.set_ylim(p_true[:, 0].max() * 1e-8, p_true[:, 0].max() * 10)
+        b.set_ylabel("PSD [m²/Hz]")
+        b.legend(loc="upper right", fontsize=7)
+        b.grid(alpha=0.3)
+    ax[-1, 0].set_xlabel("time [s]")
+    ax[-1, 1].set_xlabel("frequency [Hz]")
+    fig.suptitle("Paper 001 Fig. 7 re-created: translation-only hull, beam seas Hs 3 m Tp 8 s, RTK 1 cm")
+    fig.tight_layout()
+    fig.savefig(out / "paper001_fig7.png", dpi=100)
+    plt.close(fig)
 
 
 def tilting(rate: float = 1.0, duration: float = 600.0, settle: float = 60.0) -> dict:
