@@ -133,15 +133,16 @@ def test_tilting_case_goals(tilting_record):
     rec = tilting_record
     raw = paper001.rms(paper001.raw_gnss_cog(rec), rec["cog"], 60.0)
     corr = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(), smooth=True)
-    unc = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(attitude_correction=False))
+    paper = paper001.params(attitude_correction=False, gate=math.inf)  # the paper's filter has no gate
+    unc = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper)
     e_corr = paper001.rms(corr["pos"], rec["cog"], 60.0)
     e_unc = paper001.rms(unc["pos"], rec["cog"], 60.0)
     # 3-D: in surge (beam seas, ~1 cm of motion) GNSS held between epochs is already at its noise
     assert np.linalg.norm(e_corr) <= 0.5 * np.linalg.norm(raw), (e_corr, raw)
     assert np.linalg.norm(e_corr) * 2 <= np.linalg.norm(e_unc), (e_corr, e_unc)
-    assert np.all(e_corr < 0.015)  # measured 0.66 / 0.74 / 1.0 cm
+    assert np.all(e_corr < 0.015)  # measured 0.68 / 0.75 / 1.03 cm (600 s)
     e_smooth = paper001.rms(corr["pos_smooth"], rec["cog"], 60.0)
-    # RTS post-processing: 0.39 / 0.75 / 0.49 cm (sway is limited by the attitude in the COG transfer)
+    # RTS post-processing: 0.43 / 0.75 / 0.49 cm (sway is limited by the attitude in the COG transfer)
     assert np.linalg.norm(e_smooth) < 0.8 * np.linalg.norm(e_corr), (e_smooth, e_corr)
 
 

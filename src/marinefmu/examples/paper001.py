@@ -195,11 +195,16 @@ def _plot_fig7(result: dict, out: Path, settle: float) -> None:
 
 
 def tilting(rate: float = 1.0, duration: float = 600.0, settle: float = 60.0) -> dict:
-    """Experiment (b): full hull in beam seas; RMS errors with and without attitude correction."""
+    """Experiment (b): full hull in beam seas; RMS errors with and without attitude correction.
+
+    The uncorrected filter runs without the innovation gate, as the paper's: its acceleration
+    is off by g·sin(roll) (0.7 m/s² at 4°), so with the gate it rejects a fifth of the fixes
+    and coasts on that error (``uncorrected_gated``, 1.1 m sway RMS over 600 s)."""
     rec = simulate(duration, {"gnss.rate": rate})
     out = {"gnss": rms(raw_gnss_cog(rec), rec["cog"], settle)}
-    for name, corr in (("corrected", True), ("uncorrected", False)):
-        r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(attitude_correction=corr))
+    for name, kw in (("corrected", {}), ("uncorrected", {"attitude_correction": False, "gate": math.inf}),
+                     ("uncorrected_gated", {"attitude_correction": False})):
+        r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(**kw))
         out[name] = rms(r["pos"], rec["cog"], settle)
     return out
 
