@@ -82,7 +82,8 @@ def run(duration: float = 1200.0, noise: bool = False, mode: int | None = None, 
     params = AttitudeParams(mode=mode, init="given" if mode == 0 else "level",
                             init_euler=tuple(float(a) for a in truth[0]) if mode == 0 else (0.0, 0.0, float(truth[0, 2])))
     att = estimate_attitude(rec["gyro"], rec["acc"], DT, params)
-    if mode == 1 if refine is None else refine:
+    refine = mode == 1 if refine is None else refine
+    if refine:
         euler = np.array([quat_to_euler(q) for q in refine_tilt(att["q"], rec["acc"], DT, TILT_CUTOFF)])
     else:
         euler = np.column_stack((att["roll"], att["pitch"], att["yaw"]))
