@@ -306,7 +306,6 @@ class GnssAccFusion:
         self._model_dt: float | None = None  # Φ, G, Q below are built for this step size
         self.residual = 0.0
         self.acc_n = np.zeros(3)
-        self.prev_acc_n: np.ndarray | None = None  # a_n of the previous sample (start of the step)
 
     # ---- per step ----------------------------------------------------------------------------
     def step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None) -> FusionResult:
@@ -345,9 +344,9 @@ class GnssAccFusion:
             self.q = quat_mul(self.q, quat_from_rotvec((w_step - self.gyro_bias) * dt))
             self.q /= np.linalg.norm(self.q)
         rot = quat_to_rot(self.q)
-        self.prev_acc_n = self.acc_n if self.initialised else None
+        start = self.acc_n if self.initialised else None  # a_n at the start of the step
         self.acc_n = (rot @ f_b if p.attitude_correction else f_b) + GRAVITY_N
-        u = self.acc_n if p.step_input == "latest" or self.prev_acc_n is None else 0.5 * (self.prev_acc_n + self.acc_n)
+        u = self.acc_n if p.step_input == "latest" or start is None else 0.5 * (start + self.acc_n)
         self.since_fix += dt
         self.since_epoch += dt
         self.prior = None
