@@ -81,6 +81,28 @@ def euler_rates_to_body(euler: np.ndarray, euler_dot: np.ndarray, euler_ddot: np
     return w, a
 
 
+def body_to_euler_rates(euler: list[float], omega: list[float]) -> list[float]:
+    """ZYX Euler-angle rates from the body angular rate, Θ̇ = T(Θ) ω_b (Fossen 2021, eq. 2.41;
+    the inverse of the first half of :func:`euler_rates_to_body`, singular at pitch ±90°).
+
+    Parameters
+    ----------
+    euler : list of float
+        [φ, θ, ψ] [rad].
+    omega : list of float
+        Body angular rate [p, q, r] [rad/s].
+
+    Returns
+    -------
+    list of float
+        [φ̇, θ̇, ψ̇] [rad/s].
+    """
+    f, t = euler[0], euler[1]
+    p, q, r = omega
+    cf, sf, ct, tt = math.cos(f), math.sin(f), math.cos(t), math.tan(t)
+    return [p + (q * sf + r * cf) * tt, q * cf - r * sf, (q * sf + r * cf) / ct]
+
+
 def attitude_kinematics(euler: list[float], euler_dot: list[float], euler_ddot: list[float]) -> tuple[np.ndarray, list[float], list[float]]:
     """R_nb, ω_b and α_b in one pass (shares the trigonometry of :func:`rot_nb` and
     :func:`euler_rates_to_body`; used on the FMU hot path, checked against both in the tests).
