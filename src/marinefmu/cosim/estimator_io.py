@@ -5,6 +5,8 @@ from __future__ import annotations
 from typing import Any
 
 from ..estimators.attitude import INIT_CHOICES, AttitudeParams
+from ..estimators.centre_of_rotation import ANGLE_CHOICES as CR_ANGLE_CHOICES
+from ..estimators.centre_of_rotation import CentreOfRotationParams
 from ..estimators.gnss_fusion import ANTENNAS, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
 from ..estimators.reconstruction import TILT_CHOICES
 from ..estimators.sliding_reconstruction import SlidingParams
@@ -143,4 +145,52 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
         q=v["q"], r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
+    )
+
+
+_CR = CentreOfRotationParams()
+CR_PARAMETERS: list[Variable] = [
+    Variable("angles", "string", _CR.angles, "", f"Angle source: one of {', '.join(CR_ANGLE_CHOICES)} (high-pass integrated gyro as paper 002, or the roll/pitch/yaw inputs)"),
+    real("hp_cutoff", _CR.hp_cutoff, "Hz", "Cutoff of the high-pass angle integration (paper 002 section 3.2), (0, 1]"),
+    real("diff_window", _CR.diff_window, "s", "Savitzky-Golay window for the angular acceleration, (0, 10]; outputs lag by half of it"),
+    Variable("centripetal", "boolean", _CR.centripetal, "", "Lever-arm term alpha x o + omega x (omega x o) (false: the paper's alpha x o)"),
+    real("acc_sigma", _CR.acc_sigma, "m/s2", "Measurement noise of one specific-force sample, (0, 10]"),
+    real("acc_rw", _CR.acc_rw, "m/s2/sqrt(s)", "Random-walk density of the CR acceleration states (paper 002 eq. 1), (0, 100]"),
+    real("offset_rw", _CR.offset_rw, "m/sqrt(s)", "Random-walk density of the offset states, (0, 10]"),
+    real("offset_sigma0", _CR.offset_sigma0, "m", "Initial standard deviation of the offset, (0, 1000]"),
+    real("settle_time", _CR.settle_time, "s", "The offset is averaged after this time, [0, 1e6]"),
+    *vec("sensor", "xyz", 0.0, "m", "Sensor position relative to the COG, body frame (for cr.*)"),
+]
+CR_INPUTS: list[Variable] = [
+    *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the sensor, body frame"),
+    *vec("gyro", "xyz", 0.0, "rad/s", "Angular rate, body frame"),
+    real("roll", 0.0, "rad", "Roll (ZYX Euler), used when angles = input"),
+    real("pitch", 0.0, "rad", "Pitch (ZYX Euler), used when angles = input"),
+    real("yaw", 0.0, "rad", "Yaw (ZYX Euler), used when angles = input"),
+]
+CR_OUTPUTS: list[Variable] = [
+    *vec("offset", "xyz", 0.0, "m", "Centre of rotation relative to the sensor, body frame"),
+    *vec("offset_std", "xyz", 0.0, "m", "Standard deviation of the offset (filter covariance), body frame"),
+    *vec("offset_mean", "xyz", 0.0, "m", "Running mean of the offset after settle_time, body frame"),
+    *vec("cr", "xyz", 0.0, "m", "Centre of rotation relative to the COG (sensor + offset_mean), body frame"),
+    *vec("acc_cr", "xyz", 0.0, "m/s2", "Specific force a sensor at the centre of rotation would read, body frame"),
+    *vec("acc_cr_n", "ned", 0.0, "m/s2", "Acceleration of the centre of rotation, NED"),
+    real("roll_used", 0.0, "rad", "Roll used by the filter"),
+    real("pitch_used", 0.0, "rad", "Pitch used by the filter"),
+    real("yaw_used", 0.0, "rad", "Yaw used by the filter"),
+    real("delay", 0.0, "s", "Lag of all outputs behind the inputs (half the differentiation window)"),
+]
+CR_BOOLEANS: list[Variable] = [
+    Variable("valid", "boolean", False, "", "Differentiation window full and the sample good"),
+    Variable("settled", "boolean", False, "", "settle_time has passed: offset_mean is an average"),
+]
+
+
+def cr_params(values: dict[str, Any]) -> CentreOfRotationParams:
+    """CentreOfRotationParams from FMI-named values."""
+    v = resolve(CR_PARAMETERS, values, "CentreOfRotation")
+    return CentreOfRotationParams(
+        angles=v["angles"], hp_cutoff=v["hp_cutoff"], diff_window=v["diff_window"], centripetal=bool(v["centripetal"]),
+        acc_sigma=v["acc_sigma"], acc_rw=v["acc_rw"], offset_rw=v["offset_rw"], offset_sigma0=v["offset_sigma0"],
+        settle_time=v["settle_time"], sensor=(v["sensor.x"], v["sensor.y"], v["sensor.z"]),
     )

@@ -27,6 +27,7 @@ UNITS: dict[str, dict[str, int]] = {
     "m2/s3": {"m": 2, "s": -3},
     "m2*s": {"m": 2, "s": 1},
     "m/s2/sqrt(s)": {},
+    "m/sqrt(s)": {},
 }
 _ORDER = ("ModelExchange", "CoSimulation", "UnitDefinitions", "TypeDefinitions", "LogCategories",
           "DefaultExperiment", "VendorAnnotations", "ModelVariables", "ModelStructure")
