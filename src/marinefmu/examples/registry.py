@@ -47,6 +47,30 @@ def _faults(out: Path) -> dict:
     return paper001.faults()
 
 
+def _cr_convergence(out: Path) -> dict:
+    from . import paper002
+
+    r = paper002.convergence()
+    return {f"{name} CR error x/y/z [m]": r[name]["error"] for name in paper002.SENSORS} | {
+        "floor of the record x/y/z [m]": r["bridge"]["floor"], "bridge - aft CR x/y/z [m]": r["agreement"]["final"]}
+
+
+def _cr_weak(out: Path) -> dict:
+    from . import paper002
+
+    r = paper002.weak_translation()
+    return {f"{name} CR error x/y/z [m]": r[name]["error"] for name in paper002.SENSORS}
+
+
+def _cr_angles(out: Path) -> dict:
+    from . import paper002
+
+    r = paper002.angle_errors()
+    out.mkdir(parents=True, exist_ok=True)
+    paper002.plot(r, out / "paper002_angle_errors.png")
+    return {f"{label} ({rms:.2f} deg RMS): CR shift x/y/z [m]": np.array(shift) for label, rms, *shift in r["rows"]}
+
+
 #: name → (description, runner(out folder) → printable figures)
 EXAMPLES: dict[str, tuple[str, Callable[[Path], dict]]] = {
     "paper000-sdof": ("Paper 000 §4: SDOF Cummins model, decomposition and drift-free reconstruction", _sdof),
@@ -58,6 +82,9 @@ EXAMPLES: dict[str, tuple[str, Callable[[Path], dict]]] = {
     "paper001-tilting": ("Paper 001 Fig. 11: errors with and without attitude correction", _tilting),
     "paper001-buoy": ("Paper 001 §4.3: buoy-like case, vertical error from attitude", _buoy),
     "paper001-faults": ("Paper 001 robustness: 20 m GNSS jump and 30 s dropout at 1 Hz", _faults),
+    "paper002-convergence": ("Paper 002: CR of two sensors against known truth (10 min, MEMS noise)", _cr_convergence),
+    "paper002-weak-translation": ("Paper 002: CR with weak translations (small floor), against truth", _cr_weak),
+    "paper002-angle-errors": ("Paper 002's z discrepancy: CR shift from roll/pitch errors and the high-pass angles (plot)", _cr_angles),
 }
 
 

@@ -310,3 +310,33 @@ class VesselMotionModel:
         self.imu.set_state(state["imu"])
         self.gnss.set_state(state["gnss"])
         self.gnss_new = bool(state["gnss_new"])
+
+
+def simulate_record(params: VesselMotionParams, duration: float, dt: float = 0.01) -> dict[str, np.ndarray]:
+    """Run the in-process model and return every output as a named array.
+
+    Parameters
+    ----------
+    params : VesselMotionParams
+        Model parameters.
+    duration : float
+        Record length [s]; samples at t_k = (k + 1)·dt.
+    dt : float
+        Step [s].
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        (N,) arrays keyed by the FMU output names of :data:`REAL_OUTPUTS` and
+        :data:`BOOLEAN_OUTPUTS` (``"imu.acc.x"``, ``"truth.roll"``, ``"gnss.valid"``, …).
+    """
+    model = VesselMotionModel(params)
+    n = int(round(duration / dt))
+    y = np.empty((n, len(REAL_OUTPUTS)))
+    flags = np.empty((n, len(BOOLEAN_OUTPUTS)), dtype=bool)
+    for k in range(n):
+        y[k] = model.step((k + 1) * dt, dt)
+        flags[k] = model.boolean_outputs()
+    out = {v.name: y[:, i] for i, v in enumerate(REAL_OUTPUTS)}
+    out.update({v.name: flags[:, i] for i, v in enumerate(BOOLEAN_OUTPUTS)})
+    return out

@@ -1,0 +1,212 @@
+"""Paper 002's centre-of-rotation estimator: measurement model against a finite-difference
+rigid body, the paper's eq. 11 after the frame change, the angle and derivative kernels,
+convergence against VesselMotion's known CR, two-sensor agreement, the angle-error study, and
+bad input."""
+import logging
+import math
+
+import numpy as np
+import pytest
+
+from marinefmu.errors import MarineFmuError
+from marinefmu.estimators.centre_of_rotation import (
+    CentreOfRotation, CentreOfRotationParams, eq11_specific_force, leaky_angle_step, lever_matrix,
+    predicted_specific_force,
+)
+from marinefmu.estimators.centred_window import CentredWindow
+from marinefmu.examples import paper002
+from marinefmu.frames import G, attitude_kinematics, body_to_euler_rates, euler_rates_to_body, rot_nb
+
+# 8th-order central difference for a second derivative (truncation ~h^8, round-off ~1e-11 here)
+FD2 = np.array([-1 / 560, 8 / 315, -1 / 5, 8 / 5, -205 / 72, 8 / 5, -1 / 5, 8 / 315, -1 / 560])
+OFFSET = np.array([-5.0, 2.0, 3.5])  # CR relative to the sensor [m, b]
+
+
+def _euler(t):
+    """Analytic attitude (angles, rates, accelerations) of a rolling, pitching, yawing body."""
+    amp, w, ph = np.array([0.15, 0.08, 0.1]), np.array([0.7, 0.9, 0.4]), np.array([0.3, 1.1, -0.5])
+    return amp * np.sin(w * t + ph), amp * w * np.cos(w * t + ph), -amp * w * w * np.sin(w * t + ph)
+
+
+def _cr(t):
+    """Analytic CR position [m, NED] and its acceleration."""
+    amp, w = np.array([0.8, 0.5, 1.2]), np.array([0.6, 0.8, 1.0])
+    return amp * np.sin(w * t), -amp * w * w * np.sin(w * t)
+
+
+def _sensor_position(t):
+    return _cr(t)[0] - rot_nb(*_euler(t)[0]) @ OFFSET
+
+
+@pytest.mark.parametrize("t", [0.0, 3.7, 12.25])
+def test_measurement_model_matches_a_finite_difference_rigid_body(t):
+    h = 0.01
+    acc_sensor = sum(c * _sensor_position(t + (i - 4) * h) for i, c in enumerate(FD2)) / h ** 2
+    e, ed, edd = _euler(t)
+    rot, w, a = attitude_kinematics(list(e), list(ed), list(edd))
+    measured = rot.T @ (acc_sensor - np.array([0.0, 0.0, G]))
+    model = predicted_specific_force(rot, _cr(t)[1], OFFSET, w, a)
+    assert np.max(np.abs(model - measured)) < 1e-9
+    # the paper's model (no centripetal term) misses ω × (ω × o): visible at this resolution
+    paper = predicted_specific_force(rot, _cr(t)[1], OFFSET, w, a, centripetal=False)
+    assert np.max(np.abs(paper - measured)) > 1e-4
+    assert np.allclose(paper - model, np.cross(w, np.cross(w, OFFSET)), atol=1e-12)
+
+
+def test_eq11_as_printed_equals_ours_after_the_frame_change():
+    """Paper frames are ours rotated by π about x (y port, z up): C = diag(1, -1, -1) maps body
+    and world vectors, roll keeps its sign, pitch and yaw flip, and the paper's r points from
+    the CR to the sensor (r = -o). Eq. 11 drops ψ̈, so α_z = 0 here."""
+    rng = np.random.default_rng(3)
+    c = np.diag([1.0, -1.0, -1.0])
+    for _ in range(5):
+        roll, pitch, yaw = rng.uniform(-0.4, 0.4, 3)
+        alpha = np.array([*rng.normal(0.0, 0.05, 2), 0.0])
+        acc_cr = rng.normal(0.0, 1.0, 3)
+        ours = predicted_specific_force(rot_nb(roll, pitch, yaw), acc_cr, OFFSET, rng.normal(0.0, 0.1, 3), alpha,
+                                        centripetal=False)
+        paper = eq11_specific_force((roll, -pitch, -yaw), (alpha[0], -alpha[1], 0.0), c @ acc_cr, c @ -OFFSET)
+        assert np.allclose(paper, c @ ours, atol=1e-12)
+
+
+def test_lever_matrix_is_the_cross_products():
+    w, a = np.array([0.1, -0.2, 0.05]), np.array([0.03, 0.01, -0.02])
+    assert np.allclose(lever_matrix(w, a) @ OFFSET, np.cross(a, OFFSET) + np.cross(w, np.cross(w, OFFSET)), atol=1e-15)
+    assert np.allclose(lever_matrix(w, a, centripetal=False) @ OFFSET, np.cross(a, OFFSET), atol=1e-15)
+
+
+def test_euler_rates_invert_the_body_rates():
+    euler, ed = np.array([0.3, -0.2, 1.0]), np.array([0.05, -0.02, 0.01])
+    w, _ = euler_rates_to_body(euler, ed, np.zeros(3))
+    assert np.allclose(body_to_euler_rates(list(euler), list(w)), ed, atol=1e-15)
+
+
+def test_high_pass_angle_settles_at_rate_over_cutoff():
+    """A constant roll rate (a gyro bias) integrates to φ = p/ω_c instead of growing."""
+    euler, fc, p = [0.0, 0.0, 0.0], 0.01, 1e-4
+    for _ in range(100_000):  # 1000 s = 63 time constants at 100 Hz
+        euler = leaky_angle_step(euler, [p, 0.0, 0.0], 0.01, fc)
+    assert euler[0] == pytest.approx(p / (2 * math.pi * fc), rel=1e-9)
+
+
+def test_savgol_derivative_is_exact_for_a_quartic():
+    dt, win = 0.01, CentredWindow(1, 31, 0.01, polyorder=4)
+    x = lambda t: 1.0 - 2.0 * t + 0.5 * t ** 2 + 0.3 * t ** 3 - 0.1 * t ** 4  # noqa: E731
+    for k in range(31):
+        out = win.push([x(k * dt)])
+    tc = 15 * dt
+    assert out[2][0] == pytest.approx(-2.0 + tc + 0.9 * tc ** 2 - 0.4 * tc ** 3, abs=1e-9)
+    assert out[0][0] == x(tc) and win.delay == pytest.approx(0.15)
+
+
+# ---- against known truth (VesselMotion, vessel.mode 1, default MEMS noise, 10 minutes) ----------
+@pytest.fixture(scope="module")
+def convergence():
+    return paper002.convergence()
+
+
+def test_both_sensors_reach_the_floor_of_the_record(convergence):
+    """The filter settles where the record's sample correlation puts any estimator of its model
+    (the floor, computed from exact data): within 0.1 m per axis with MEMS noise and the
+    high-pass angles (measured 0.05 / 0.08 m in y). The floor itself is 0.5 m in y here, which is
+    why the absolute 0.1 m goal needs weaker translations (next test) or longer records."""
+    for name in paper002.SENSORS:
+        r = convergence[name]
+        assert np.all(np.abs(r["error"] - r["floor"]) < 0.1), (name, r)
+
+
+def test_two_sensors_on_one_rigid_body_agree(convergence):
+    """The floor is the same for every sensor position, so the CR estimates agree (0.2 m goal;
+    measured 0.03 m)."""
+    assert np.all(np.abs(convergence["agreement"]["final"]) < 0.2)
+    assert np.all(np.abs(convergence["agreement"]["mean"]) < 0.2)
+
+
+def test_offset_error_below_10_cm_when_the_floor_allows():
+    """Translations 20x weaker than the rotations' lever effects (floor 0.03 m): the estimate
+    is within 0.1 m of the true CR after 10 minutes with MEMS noise (measured 0.044 m)."""
+    res = paper002.weak_translation()
+    for name in paper002.SENSORS:
+        assert np.all(np.abs(res[name]["error"]) < 0.1), (name, res[name])
+
+
+def test_angle_errors_in_phase_with_the_motion_move_the_cr_height():
+    """Paper 002's z discrepancy: a constant misalignment is absorbed (|Δz| < 5 cm at 1°), an
+    error proportional to the angle is not (|Δz| > 1 m at 1° RMS; measured 3.5 m), the
+    high-pass angles add 0.4 m at 0.05 Hz, and the drift-corrected attitude removes it."""
+    rows = {r[0]: r for r in paper002.angle_errors()["rows"]}
+    assert abs(rows["misaligned 1.0°"][4]) < 0.05
+    assert abs(rows["proportional 1.0°"][4]) > 1.0
+    assert abs(rows["proportional 0.1°"][4]) < abs(rows["proportional 1.0°"][4]) / 5
+    assert abs(rows["high-pass 0.05 Hz"][4]) > 5 * abs(rows["high-pass 0.005 Hz"][4])
+    assert np.all(np.abs(rows["AttitudeEstimator"][2:]) < 0.05)
+
+
+# ---- bad input ----------------------------------------------------------------------------------
+@pytest.mark.parametrize("field,value,message", [
+    ("acc_sigma", 0.0, "acc_sigma = 0.0 is out of range"),
+    ("acc_rw", -1.0, "acc_rw = -1.0 is out of range"),
+    ("offset_rw", 0.0, "offset_rw = 0.0 is out of range"),
+    ("offset_sigma0", 0.0, "offset_sigma0 = 0.0 is out of range"),
+    ("hp_cutoff", 0.0, "hp_cutoff = 0.0 is out of range"),
+    ("hp_cutoff", -0.1, "hp_cutoff = -0.1 is out of range"),
+    ("diff_window", 0.0, "diff_window = 0.0 is out of range"),
+    ("angles", "gyro", "angles = 'gyro' is not allowed"),
+    ("centripetal", "yes", "centripetal must be True or False"),
+])
+def test_bad_parameters_are_refused_by_name(field, value, message):
+    with pytest.raises(MarineFmuError, match=message):
+        CentreOfRotationParams(**{field: value})
+
+
+def _drive(est, n, start=0, bad=None):
+    rng = np.random.default_rng(start)
+    out = []
+    for k in range(start, start + n):
+        t = (k + 1) * 0.01
+        acc = [0.3 * math.sin(t), 0.2 * math.cos(0.7 * t), -G + 0.1 * math.sin(1.3 * t)] + rng.normal(0, 0.01, 3)
+        gyro = [0.02 * math.cos(0.9 * t), 0.01 * math.sin(0.6 * t), 0.0]
+        if bad is not None and k == bad[0]:
+            acc[bad[1]] = bad[2]
+        out.append(est.step(acc, gyro, 0.01, [0.01, 0.0, 0.0]))
+    return out
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, 1e6])
+def test_bad_sample_holds_with_valid_false_and_a_warning(value, caplog):
+    est = CentreOfRotation()
+    _drive(est, 300)
+    with caplog.at_level(logging.WARNING):
+        r = _drive(est, 2, start=300, bad=(300, 1, value))
+    assert not r[0].valid and r[0].warning is not None and r[1].valid
+    assert all(np.isfinite(v) for f in ("offset", "offset_std", "acc_cr", "acc_cr_n", "euler") for v in getattr(r[0], f))
+    assert "holding the last good sample" in caplog.text
+
+
+def test_nan_angle_input_is_a_bad_sample():
+    est = CentreOfRotation(CentreOfRotationParams(angles="input"))
+    _drive(est, 300)
+    r = est.step([0.0, 0.0, -G], [0.0, 0.0, 0.0], 0.01, [math.nan, 0.0, 0.0])
+    assert not r.valid and "roll, pitch or yaw" in r.warning
+
+
+def test_first_sample_bad_gives_invalid_zero_output():
+    r = CentreOfRotation().step([math.nan, 0.0, -G], [0.0, 0.0, 0.0], 0.01)
+    assert not r.valid and r.offset == (0.0, 0.0, 0.0)
+
+
+def test_step_size_change_restarts_the_window():
+    est = CentreOfRotation(CentreOfRotationParams(diff_window=0.1))
+    _drive(est, 50)
+    r = est.step([0.0, 0.0, -G], [0.0, 0.0, 0.0], 0.02)
+    assert not r.valid and "step size changed" in r.warning
+
+
+def test_state_round_trip_reproduces_the_run():
+    est = CentreOfRotation()
+    _drive(est, 400)
+    saved = est.get_state()
+    first = _drive(est, 100, start=400)
+    other = CentreOfRotation()
+    other.set_state(saved)
+    assert _drive(other, 100, start=400) == first
