@@ -37,3 +37,47 @@ def test_vessel_motion_runs_in_libcosim_and_matches_in_process(fmu_dir):
     # libcosim keeps time in integer nanoseconds; the converted doubles differ from k·0.01 by ~1 ulp
     np.testing.assert_allclose(got, ref, rtol=1e-9, atol=1e-9)
     assert abs(got[REAL_OUTPUTS.index(next(v for v in REAL_OUTPUTS if v.name == "truth.cog.d"))]) > 1e-3
+
+
+def test_centre_of_rotation_fed_by_vessel_motion_in_libcosim(fmu_dir):
+    """VesselMotion (independent-rotation mode) wired to CentreOfRotation in libcosim equals the
+    in-process pair; libcosim passes each output on at the next communication point, so the
+    estimator sees the vessel's sample of the previous step (its initial values at step 0)."""
+    from fmpy import read_model_description
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    from marinefmu.estimators.centre_of_rotation import CentreOfRotation, CentreOfRotationParams
+    from marinefmu.sea.motion_model import REAL_INDEX
+
+    log_output_level(CosimLogLevel.ERROR)
+    vpath, cpath = fmu_dir / "VesselMotion.fmu", fmu_dir / "CentreOfRotation.fmu"
+    vvr = {v.name: v.valueReference for v in read_model_description(str(vpath)).modelVariables}
+    cvr = {v.name: v.valueReference for v in read_model_description(str(cpath)).modelVariables}
+    params = {"vessel.mode": 1, "vessel.cr.x": 3.0, "vessel.cr.z": -1.5, "imu.x": 8.0, "imu.y": 2.0, "imu.z": -4.0}
+    dt_ns, steps = 10_000_000, 1500
+    ex = CosimExecution.from_step_size(step_size=dt_ns)
+    v = ex.add_local_slave(CosimLocalSlave(fmu_path=str(vpath), instance_name="vessel"))
+    c = ex.add_local_slave(CosimLocalSlave(fmu_path=str(cpath), instance_name="cr"))
+    for k, val in params.items():
+        assert (ex.integer_initial_value if k == "vessel.mode" else ex.real_initial_value)(v, vvr[k], val)
+    assert ex.string_initial_value(v, vvr["vessel.preset"], "research36")
+    wires = [(f"imu.{s}.{a}", f"{s}.{a}") for s in ("acc", "gyro") for a in "xyz"]
+    for src, dst in wires:
+        assert ex.connect_real_variables(v, vvr[src], c, cvr[dst]) == 0  # a libcosim status code: 0 is success
+    obs = CosimObserver.create_last_value()
+    ex.add_observer(obs)
+    assert ex.simulate_until(steps * dt_ns)
+    outs = ["offset.x", "offset.y", "offset.z", "acc_cr.z"]
+    got = np.array(obs.last_real_values(c, [cvr[n] for n in outs]))
+
+    m = VesselMotionModel(VesselMotionParams.from_flat({**params, "vessel.preset": "research36"}))
+    est = CentreOfRotation(CentreOfRotationParams())
+    y = m.peek(0.0)
+    for k in range(steps):
+        r = est.step([y[REAL_INDEX[f"imu.acc.{a}"]] for a in "xyz"], [y[REAL_INDEX[f"imu.gyro.{a}"]] for a in "xyz"], 0.01)
+        y = m.step(k * 0.01 + 0.01, 0.01)
+    np.testing.assert_allclose(got, [*r.offset, r.acc_cr[2]], rtol=1e-7, atol=1e-9)
+    assert r.valid and np.all(np.abs(r.offset) > 0.0)
