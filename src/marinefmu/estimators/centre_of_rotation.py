@@ -59,7 +59,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -366,7 +366,7 @@ class CentreOfRotation:
         self.kf = KalmanFilter(dim_x=6, dim_z=3)
         self.kf.P = np.diag([1.0] * 3 + [p.offset_sigma0 ** 2] * 3)
         self.kf.R = np.eye(3) * p.acc_sigma ** 2
-        self._result = self._output(None, np.zeros(3), np.zeros(3), [0.0, 0.0, 0.0], np.zeros(3), False, None)
+        self._result = self._output(None, np.zeros(3), [0.0, 0.0, 0.0], False, None)
 
     def _start(self, dt: float) -> None:
         p = self.params
@@ -433,29 +433,25 @@ class CentreOfRotation:
         if self.filtered_time >= p.settle_time - 1e-9:
             self.mean_sum += kf.x[3:6, 0]
             self.mean_count += 1
-        self._result = self._output(rot, omega, alpha, angles, f_b, warning is None, warning)
+        self._result = self._output(f_b, alpha, angles, warning is None, warning)
         return self._result
 
     def _invalid(self, warning: str | None) -> CentreOfRotationResult:
-        r = self._result
-        return CentreOfRotationResult(r.offset, r.offset_std, r.offset_mean, r.cr, r.acc_cr, r.acc_cr_n, r.euler,
-                                      r.ang_acc, self.delay, False, r.settled, warning)
+        return replace(self._result, delay=self.delay, valid=False, warning=warning)
 
     @property
     def delay(self) -> float:
         """Lag of the estimate behind the newest sample [s] (half the differentiation window)."""
         return self.window.delay if self.window is not None else 0.0
 
-    def _output(self, rot: np.ndarray | None, omega: np.ndarray, alpha: np.ndarray, angles: list[float],
-                f_b: np.ndarray, valid: bool, warning: str | None) -> CentreOfRotationResult:
+    def _output(self, f_b: np.ndarray | None, alpha: np.ndarray, angles: list[float], valid: bool,
+                warning: str | None) -> CentreOfRotationResult:
         x = self.kf.x[:, 0]
         offset = x[3:6]
         std = np.sqrt(np.diag(self.kf.P)[3:6])
         mean = self.mean_sum / self.mean_count if self.mean_count else offset
-        if rot is None:
-            acc_cr = np.zeros(3)
-        else:  # what a sensor at the CR would read: f_b + M o
-            acc_cr = f_b + lever_matrix(omega, alpha, self.params.centripetal) @ offset
+        # what a sensor at the CR would read: f_b + M o, with −M the offset block of this step's H
+        acc_cr = np.zeros(3) if f_b is None else f_b - self.kf.H[:, 3:6] @ offset
         t = lambda v: tuple(float(a) for a in v)  # noqa: E731
         return CentreOfRotationResult(
             t(offset), t(std), t(mean), t(np.asarray(self.params.sensor) + mean), t(acc_cr), t(x[0:3]), t(angles),

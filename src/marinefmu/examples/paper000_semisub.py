@@ -20,7 +20,7 @@ from ..estimators.attitude import AttitudeParams, estimate_attitude
 from ..estimators.tilt_refinement import refine_tilt
 from ..estimators.reconstruction import lever_arm_offset, reconstruct_displacement, tilt_correct
 from ..frames import quat_to_euler
-from ..sea.motion_model import REAL_INDEX, VesselMotionModel, VesselMotionParams
+from ..sea.motion_model import VesselMotionParams, simulate_record, stack
 
 LEVER_ARM = (41.0, 35.0, -35.0)
 SEA = {"sea.hs": 10.0, "sea.tp": 12.0, "sea.heading": 2.6, "vessel.preset": "semisub"}
@@ -42,16 +42,10 @@ def simulate(duration: float, noise: bool, seed: int = 1) -> dict[str, np.ndarra
     values = {**SEA, "sea.seed": seed, "imu.x": LEVER_ARM[0], "imu.y": LEVER_ARM[1], "imu.z": LEVER_ARM[2]}
     if not noise:
         values.update(NOISE_FREE)
-    model = VesselMotionModel(VesselMotionParams.from_flat(values))
-    n = int(round(duration / DT))
-    y = np.array([model.step((k + 1) * DT, DT) for k in range(n)])
-
-    def cols(names: list[str]) -> np.ndarray:
-        return y[:, [REAL_INDEX[c] for c in names]]
-
+    rec = simulate_record(VesselMotionParams.from_flat(values), duration, DT)
     return {
-        "gyro": cols([f"imu.gyro.{a}" for a in "xyz"]), "acc": cols([f"imu.acc.{a}" for a in "xyz"]),
-        "euler": cols(["truth.roll", "truth.pitch", "truth.yaw"]), "cog": cols([f"truth.cog.{a}" for a in "ned"]),
+        "gyro": stack(rec, "imu.gyro"), "acc": stack(rec, "imu.acc"),
+        "euler": stack(rec, "truth", ("roll", "pitch", "yaw")), "cog": stack(rec, "truth.cog", "ned"),
     }
 
 

@@ -24,7 +24,7 @@ import numpy as np
 from scipy import signal
 
 from ..estimators.gnss_fusion import FusionParams, fuse
-from ..sea.motion_model import REAL_INDEX, VesselMotionModel, VesselMotionParams
+from ..sea.motion_model import VesselMotionParams, simulate_record, stack
 from ..sea.vessel import preset_raos, save_rao_csv
 
 DT = 0.01
@@ -44,21 +44,12 @@ def _flat(extra: dict) -> dict:
 def simulate(duration: float, extra: dict | None = None) -> dict[str, np.ndarray]:
     """VesselMotion record at 100 Hz: acc, gyro (N, 3), gnss (N, 12), gnss_new and gnss_valid
     (N,), cog (N, 3), euler (N, 3)."""
-    model = VesselMotionModel(VesselMotionParams.from_flat(_flat(extra or {})))
-    n = int(round(duration / DT))
-    y = np.empty((n, len(REAL_INDEX)))
-    flags = np.empty((n, 2), dtype=bool)
-    for k in range(n):
-        y[k] = model.step((k + 1) * DT, DT)
-        flags[k] = model.boolean_outputs()[:2]
-
-    def cols(names: list[str]) -> np.ndarray:
-        return y[:, [REAL_INDEX[c] for c in names]]
-
+    rec = simulate_record(VesselMotionParams.from_flat(_flat(extra or {})), duration, DT)
     return {
-        "acc": cols([f"imu.acc.{a}" for a in "xyz"]), "gyro": cols([f"imu.gyro.{a}" for a in "xyz"]),
-        "gnss": cols([f"gnss.ant{i}.{a}" for i in range(1, 5) for a in "ned"]), "gnss_new": flags[:, 1], "gnss_valid": flags[:, 0],
-        "cog": cols([f"truth.cog.{a}" for a in "ned"]), "euler": cols(["truth.roll", "truth.pitch", "truth.yaw"]),
+        "acc": stack(rec, "imu.acc"), "gyro": stack(rec, "imu.gyro"),
+        "gnss": np.hstack([stack(rec, f"gnss.ant{i}", "ned") for i in range(1, 5)]),
+        "gnss_new": rec["gnss.new"], "gnss_valid": rec["gnss.valid"],
+        "cog": stack(rec, "truth.cog", "ned"), "euler": stack(rec, "truth", ("roll", "pitch", "yaw")),
     }
 
 

@@ -30,7 +30,7 @@ from ..estimators.centre_of_rotation import (
     CentreOfRotationParams, estimate_centre_of_rotation, lever_matrix, offset_floor,
 )
 from ..frames import rot_nb
-from ..sea.motion_model import VesselMotionParams, simulate_record
+from ..sea.motion_model import VesselMotionParams, simulate_record, stack
 from ..sea.vessel import preset_raos, save_rao_csv
 
 DT = 0.01
@@ -52,17 +52,13 @@ def record(sensor: tuple[float, float, float], seed: int = 7, duration: float = 
     return simulate_record(VesselMotionParams.from_flat(flat), duration, DT)
 
 
-def _cols(rec: dict, prefix: str, axes: str = "xyz") -> np.ndarray:
-    return np.column_stack([rec[f"{prefix}.{a}"] for a in axes])
-
-
 def truth_floor(rec: dict, sensor: tuple[float, float, float]) -> np.ndarray:
     """:func:`offset_floor` of a record, from its exact CR acceleration [m, b]."""
-    rot = np.array([rot_nb(*e) for e in _cols(rec, "truth", ("roll", "pitch", "yaw"))])
-    w, a = _cols(rec, "truth.rate"), _cols(rec, "truth.ang_acc")
-    arm = np.asarray(sensor) - _cols(rec, "truth.cr")[0]
+    rot = np.array([rot_nb(*e) for e in stack(rec, "truth", ("roll", "pitch", "yaw"))])
+    w, a = stack(rec, "truth.rate"), stack(rec, "truth.ang_acc")
+    arm = np.asarray(sensor) - stack(rec, "truth.cr")[0]
     lever = np.array([lever_matrix(wk, ak) @ arm for wk, ak in zip(w, a)])
-    acc_cr = _cols(rec, "truth.imu_acc", "ned") - np.einsum("kij,kj->ki", rot, lever)
+    acc_cr = stack(rec, "truth.imu_acc", "ned") - np.einsum("kij,kj->ki", rot, lever)
     return offset_floor(acc_cr, rot, w, a)
 
 
@@ -70,7 +66,7 @@ def estimate(rec: dict, sensor: tuple[float, float, float], euler: np.ndarray | 
              **params) -> dict[str, np.ndarray]:
     """Run the estimator on a record (``euler`` given: ``angles="input"``)."""
     p = CentreOfRotationParams(sensor=sensor, angles="input" if euler is not None else "gyro_hp", **params)
-    return estimate_centre_of_rotation(_cols(rec, "imu.acc"), _cols(rec, "imu.gyro"), DT, p, euler)
+    return estimate_centre_of_rotation(stack(rec, "imu.acc"), stack(rec, "imu.gyro"), DT, p, euler)
 
 
 def convergence(seed: int = 7, extra: dict | None = None, duration: float = DURATION) -> dict[str, dict]:
@@ -82,7 +78,7 @@ def convergence(seed: int = 7, extra: dict | None = None, duration: float = DURA
     for name, sensor in SENSORS.items():
         rec = record(sensor, seed, duration, extra)
         r = estimate(rec, sensor)
-        truth = _cols(rec, "truth.cr")[-1]
+        truth = stack(rec, "truth.cr")[-1]
         final = r["offset"][-1] + sensor
         out[name] = {"error": final - truth, "mean_error": r["cr"][-1] - truth,
                      "floor": truth_floor(rec, sensor), "std": r["offset_std"][-1]}
@@ -107,7 +103,7 @@ def angle_errors(seed: int = 7, sensor: str = "bridge", duration: float = DURATI
     error [deg], CR shift x, y, z against the same sensor with exact angles)."""
     arm = SENSORS[sensor]
     rec = record(arm, seed, duration)
-    euler = _cols(rec, "truth", ("roll", "pitch", "yaw"))
+    euler = stack(rec, "truth", ("roll", "pitch", "yaw"))
     ref = estimate(rec, arm, euler)["offset"][-1]
     rows: list[tuple] = []
 
@@ -126,7 +122,7 @@ def angle_errors(seed: int = 7, sensor: str = "bridge", duration: float = DURATI
         add(f"proportional {e}°", euler * (1.0 + k))
     for fc in HP_CUTOFFS:
         add(f"high-pass {fc} Hz", None, hp_cutoff=fc)
-    att = estimate_attitude(_cols(rec, "imu.gyro"), _cols(rec, "imu.acc"), DT)
+    att = estimate_attitude(stack(rec, "imu.gyro"), stack(rec, "imu.acc"), DT)
     add("AttitudeEstimator", np.column_stack((att["roll"], att["pitch"], att["yaw"])))
     return {"rows": rows}
 

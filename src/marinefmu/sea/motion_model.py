@@ -340,3 +340,9 @@ def simulate_record(params: VesselMotionParams, duration: float, dt: float = 0.0
     out = {v.name: y[:, i] for i, v in enumerate(REAL_OUTPUTS)}
     out.update({v.name: flags[:, i] for i, v in enumerate(BOOLEAN_OUTPUTS)})
     return out
+
+
+def stack(record: dict[str, np.ndarray], prefix: str, axes: Any = "xyz") -> np.ndarray:
+    """(N, len(axes)) array of the outputs ``prefix.axis`` of a :func:`simulate_record` record,
+    e.g. ``stack(rec, "imu.acc")`` or ``stack(rec, "truth", ("roll", "pitch", "yaw"))``."""
+    return np.column_stack([record[f"{prefix}.{a}"] for a in axes])
