@@ -1,0 +1,493 @@
+"""Adaptive heave observer with transfer to a remote point (paper 003, Auestad, Gravdahl &
+Fossen, "Heave motion estimation on a craft using a strapdown inertial measurement unit").
+
+Heave (positive down, NED, relative to the mean position) is estimated from the vertical
+acceleration with no model of the craft, in the paper's four steps:
+
+1. **Spectrum** of the vertical acceleration over the last ``window`` seconds and the position
+   spectrum A(ω) = Ä(ω)/ω² (eq. 2), :func:`~.wave_peaks.acceleration_spectrum`.
+2. **Peaks** of A(ω) every ``peak_interval`` seconds (paper: T = 15 s) inside
+   [``omega_min``, ``omega_max``], at most ``max_modes``, :func:`~.wave_peaks.find_modes`.
+3. **Observer**: a Kalman filter over undamped oscillator modes at the peak frequencies plus a
+   random-walk offset (eqs. 3-9), :mod:`.oscillator_bank`; exact (rotation) discretisation by
+   default, the Euler form of eq. 9 selectable; steady-state gain per mode set (``dlqe``).
+   When the mode set changes, the state is carried over (:func:`~.oscillator_bank.carry_map`)
+   so heave has no transient. The first time modes are found, the filter is run over the
+   buffered window (the paper initialises from the FFT's amplitudes and phases instead), so it
+   starts converged.
+4. **Transfer** to the point at lever arm r from the IMU (body frame):
+   ``transfer="exact"`` (default) D_p = D + [R_nb r]_d − r_z, the exact rigid-body relation
+   generalising eqs. 10-11 to a 3-D lever arm; ``transfer="paper"`` is eqs. 10-11 as printed,
+   D_p = cosθ cosφ (z − r_x tanθ) (a point on the IMU's centreline and baseline).
+
+**Vertical acceleration** (the measurement, eq. 6). ``vertical="tilt"`` (default, needs only
+acc.z): a_d = f_z / (cosθ cosφ) + g, which removes gravity exactly and leaves only the
+horizontal accelerations times the tilt; ``vertical="ned"`` uses the whole specific force,
+a_d = [R_nb f_b]_d + g (exact; needs acc.x, acc.y); ``vertical="paper"`` is eq. 6 as printed:
+the body-axis f_z itself, whose gravity part −g cosθ cosφ the offset state absorbs
+(x_off(0) = −g cosθ cosφ, eq. 7) and whose output is heave along the body z axis.
+
+**Heave rate at the point** needs the angle rates; they come from the roll and pitch inputs by a
+second-order backward difference (no lag, error O((ωΔt)²)).
+
+**Delayed heave**: a fixed-lag smoother over ``smoother_lag`` seconds
+(:class:`~.fixed_lag.FixedLagOutputs`), output with its delay.
+
+Bad samples (non-finite or absurd acceleration or angles) are not used: the observer coasts on
+its model (prediction without update), the spectrum buffer takes the predicted acceleration,
+``valid`` goes false and the step reports a warning.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, check_choice, check_int, check_range, check_vector
+from ..frames import G
+from .fixed_lag import FixedLagOutputs
+from .oscillator_bank import DISCRETISATIONS, MEASUREMENTS, BankModel, build_bank, carry_map
+from .samples import MAX_SPECIFIC_FORCE
+from .wave_peaks import acceleration_spectrum, find_modes
+
+log = logging.getLogger(__name__)
+
+VERTICAL_CHOICES = ("tilt", "ned", "paper")
+TRANSFER_CHOICES = ("exact", "paper")
+#: Largest |roll|, |pitch| accepted as a physical sample [rad].
+MAX_TILT = 1.2
+
+
+@dataclass(frozen=True)
+class HeaveObserverParams:
+    """Parameters of :class:`HeaveObserver` (FMU names in brackets).
+
+    Parameters
+    ----------
+    window : float
+        Length of the spectrum window [s], at least two periods of ``omega_min``
+        (4π/omega_min) and at most 3600. [``window``]
+    peak_interval : float
+        Time between peak detections [s], (0, 3600] (paper: T = 15 s). [``peak_interval``]
+    max_modes : int
+        Most oscillator modes, 1..20. [``max_modes``]
+    omega_min, omega_max : float
+        Band searched for peaks [rad/s], 0 < omega_min < omega_max ≤ 20. [``omega_min``, ``omega_max``]
+    min_separation : float
+        Peaks closer than this to a higher one are dropped [rad/s], (0, 2]. [``min_separation``]
+    min_relative : float
+        Peaks lower than this fraction of the highest are dropped, [0, 1). [``min_relative``]
+    acc_noise : float
+        Accelerometer white-noise density N [m/s²/√Hz], (0, 1]: R = N²/Δt. [``acc_noise``]
+    mode_noise : float
+        Mode process-noise density per rad/s of mode frequency [m²/s²], (0, 1e3]:
+        q_j = mode_noise·ω_j (paper section 2.3). [``mode_noise``]
+    offset_noise : float
+        Random-walk density of the offset state [m/s²/√s], (0, 10] (eq. 7). [``offset_noise``]
+    discretisation : str
+        ``"exact"`` (rotation matrix) or ``"euler"`` (eq. 9). [``discretisation``]
+    measurement : str
+        ``"increment"`` (the mean acceleration over a step, default) or ``"paper"`` (eq. 9,
+        y = Cx), :mod:`.oscillator_bank`. [``measurement``]
+    vertical : str
+        ``"tilt"``, ``"ned"`` or ``"paper"`` (module docstring). [``vertical``]
+    transfer : str
+        ``"exact"`` or ``"paper"`` (eqs. 10-11). [``transfer``]
+    point : tuple of float
+        Monitoring point relative to the IMU, body frame [m]. [``point.{x,y,z}``]
+    smoother_lag : float
+        Delay of the delayed heave [s], [0, 120]. [``smoother_lag``]
+    """
+
+    window: float = 120.0
+    peak_interval: float = 15.0
+    max_modes: int = 6
+    omega_min: float = 0.25
+    omega_max: float = 3.0
+    min_separation: float = 0.06
+    min_relative: float = 0.05
+    acc_noise: float = 7e-4
+    mode_noise: float = 1e-2
+    offset_noise: float = 3e-4
+    discretisation: str = "exact"
+    measurement: str = "increment"
+    vertical: str = "tilt"
+    transfer: str = "exact"
+    point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    smoother_lag: float = 5.0
+
+    def __post_init__(self) -> None:
+        check_range("omega_min", self.omega_min, lo=0.0, hi=20.0, lo_open=True, unit="rad/s")
+        check_range("omega_max", self.omega_max, lo=self.omega_min, hi=20.0, lo_open=True, unit="rad/s")
+        shortest = 4.0 * math.pi / self.omega_min
+        check_range("window", self.window, lo=shortest, hi=3600.0, unit="s (two periods of omega_min)")
+        check_range("peak_interval", self.peak_interval, lo=0.0, hi=3600.0, lo_open=True, unit="s")
+        check_int("max_modes", self.max_modes, lo=1, hi=20)
+        check_range("min_separation", self.min_separation, lo=0.0, hi=2.0, lo_open=True, unit="rad/s")
+        check_range("min_relative", self.min_relative, lo=0.0, hi=1.0, hi_open=True)
+        check_range("acc_noise", self.acc_noise, lo=0.0, hi=1.0, lo_open=True, unit="m/s2/sqrt(Hz)")
+        check_range("mode_noise", self.mode_noise, lo=0.0, hi=1e3, lo_open=True, unit="m2/s2")
+        check_range("offset_noise", self.offset_noise, lo=0.0, hi=10.0, lo_open=True, unit="m/s2/sqrt(s)")
+        check_choice("discretisation", self.discretisation, DISCRETISATIONS)
+        check_choice("measurement", self.measurement, MEASUREMENTS)
+        check_choice("vertical", self.vertical, VERTICAL_CHOICES)
+        check_choice("transfer", self.transfer, TRANSFER_CHOICES)
+        check_vector("point", self.point, unit="m")
+        check_range("smoother_lag", self.smoother_lag, lo=0.0, hi=120.0, unit="s")
+
+
+# ---- stateless kernels ----------------------------------------------------------------------
+def vertical_acceleration(acc: Any, roll: float, pitch: float, vertical: str = "tilt") -> float:
+    """The observer's measurement from one specific-force sample (eq. 6 and its improvements).
+
+    Parameters
+    ----------
+    acc : array_like
+        (3,) specific force f_b [m/s², body]; ``"tilt"`` and ``"paper"`` use only f_z.
+    roll, pitch : float
+        φ, θ [rad].
+    vertical : str
+        ``"tilt"``: f_z/(cosθ cosφ) + g; ``"ned"``: [R_nb f_b]_d + g (exact); ``"paper"``: f_z.
+
+    Returns
+    -------
+    float
+        [m/s²], positive down (for ``"paper"``: along body z, including gravity).
+    """
+    fx, fy, fz = acc
+    if vertical == "paper":
+        return float(fz)
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    if vertical == "tilt":
+        return float(fz) / (cp * cr) + G
+    return -sp * float(fx) + cp * sr * float(fy) + cp * cr * float(fz) + G
+
+
+def point_heave(heave: float, rate: float, point: Any, roll: float, pitch: float, roll_rate: float,
+                pitch_rate: float, transfer: str = "exact") -> tuple[float, float]:
+    """Step 4: heave and heave rate at a point from those at the IMU.
+
+    Parameters
+    ----------
+    heave, rate : float
+        At the IMU [m], [m/s], positive down.
+    point : array_like
+        (3,) r, the point relative to the IMU [m, body].
+    roll, pitch : float
+        φ, θ [rad].
+    roll_rate, pitch_rate : float
+        φ̇, θ̇ [rad/s].
+    transfer : str
+        ``"exact"``: D_p = D + [R_nb r]_d − r_z (yaw does not enter); ``"paper"``: eqs. 10-11,
+        D_p = cosθ cosφ (D − r_x tanθ), and its time derivative.
+
+    Returns
+    -------
+    tuple of float
+        Heave [m] and heave rate [m/s] at the point, positive down.
+    """
+    rx, ry, rz = point
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    if transfer == "paper":
+        bow = heave - rx * sp / cp
+        bow_rate = rate - rx * pitch_rate / cp**2
+        c = cp * cr
+        c_rate = -sp * cr * pitch_rate - cp * sr * roll_rate
+        return c * bow, c_rate * bow + c * bow_rate
+    arm_d = -sp * rx + cp * sr * ry + cp * cr * rz
+    arm_rate = (-cp * rx - sp * sr * ry - sp * cr * rz) * pitch_rate + (cp * cr * ry - cp * sr * rz) * roll_rate
+    return heave + arm_d - rz, rate + arm_rate
+
+
+def backward_rate(history: list[tuple[float, float]], dt: float) -> tuple[float, float]:
+    """Second-order backward difference (3x_k − 4x_{k−1} + x_{k−2})/(2Δt) of (roll, pitch);
+    first order with two samples, zero with one."""
+    if len(history) >= 3:
+        (a0, b0), (a1, b1), (a2, b2) = history[-1], history[-2], history[-3]
+        return (3 * a0 - 4 * a1 + a2) / (2 * dt), (3 * b0 - 4 * b1 + b2) / (2 * dt)
+    if len(history) == 2:
+        return (history[-1][0] - history[-2][0]) / dt, (history[-1][1] - history[-2][1]) / dt
+    return 0.0, 0.0
+
+
+def central_rate(prev: tuple[float, float], nxt: tuple[float, float], dt: float) -> tuple[float, float]:
+    """Central difference (x_{k+1} − x_{k−1})/(2Δt) of (roll, pitch) [rad/s]."""
+    return (nxt[0] - prev[0]) / (2 * dt), (nxt[1] - prev[1]) / (2 * dt)
+
+
+def _bad_sample(acc: np.ndarray, roll: float, pitch: float) -> str | None:
+    if not (np.all(np.isfinite(acc)) and math.isfinite(roll) and math.isfinite(pitch)):
+        return "non-finite acceleration or angle sample"
+    if max(abs(roll), abs(pitch)) > MAX_TILT:
+        return f"roll or pitch beyond ±{MAX_TILT} rad"
+    if np.max(np.abs(acc)) > MAX_SPECIFIC_FORCE:
+        return f"specific force beyond {MAX_SPECIFIC_FORCE} m/s²"
+    return None
+
+
+# ---- stateful observer ----------------------------------------------------------------------
+@dataclass(frozen=True)
+class HeaveResult:
+    """Output of one :meth:`HeaveObserver.step`.
+
+    Attributes
+    ----------
+    heave, heave_rate : float
+        At the IMU [m], [m/s], positive down (``vertical="paper"``: along body z).
+    point_heave, point_heave_rate : float
+        At the monitoring point [m], [m/s], positive down.
+    delayed_heave, delayed_heave_rate, delayed_point_heave : float
+        Fixed-lag smoothed heave, rate at the IMU and heave at the point, for the time
+        ``delay`` s before this sample [m], [m/s].
+    delay : float
+        Lag of the delayed outputs [s].
+    offset : float
+        Offset state [m/s²] (accelerometer bias along the vertical; ``vertical="paper"``: plus
+        −g cosθ cosφ).
+    modes : int
+        Number of oscillator modes (0 before the first spectrum).
+    peak_period : float
+        Period of the highest peak of A(ω) [s] (0 before the first spectrum).
+    omega : tuple of float
+        Mode frequencies [rad/s].
+    valid : bool
+        Modes found and the sample good.
+    delayed_valid : bool
+        The delayed outputs refer to a time the observer has run through.
+    warning : str or None
+        Why the sample was not used, if it was not.
+    """
+
+    heave: float
+    heave_rate: float
+    point_heave: float
+    point_heave_rate: float
+    delayed_heave: float
+    delayed_heave_rate: float
+    delayed_point_heave: float
+    delay: float
+    offset: float
+    modes: int
+    peak_period: float
+    omega: tuple[float, ...]
+    valid: bool
+    delayed_valid: bool
+    warning: str | None = None
+
+
+class HeaveObserver:
+    """Heave at the IMU and at a point from vertical acceleration and roll/pitch (module docstring).
+
+    Parameters
+    ----------
+    params : HeaveObserverParams, optional
+        Validated parameters (defaults if omitted).
+
+    Examples
+    --------
+    >>> obs = HeaveObserver(HeaveObserverParams(window=60.0))
+    >>> r = obs.step(-9.80665, 0.0, 0.0, 0.1)
+    >>> r.valid, r.modes      # no spectrum before the first window is full
+    (False, 0)
+    """
+
+    def __init__(self, params: HeaveObserverParams | None = None) -> None:
+        self.params = params or HeaveObserverParams()
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the initial state."""
+        self.dt: float | None = None
+        self.buf: np.ndarray | None = None     # (window samples, 4): a_v, roll, pitch, good
+        self.k = 0                              # samples seen
+        self.next_detect = 0
+        self.model: BankModel | None = None
+        self.xp = np.zeros(1)                   # prior for the next measurement
+        self.x = np.zeros(1)                    # estimate at the newest sample's time
+        self.prev: tuple[float | None, np.ndarray] | None = None   # last sample: a_v, aux
+        self.angles: list[tuple[float, float]] = []
+        self.last_angles = (0.0, 0.0)
+        self.peak_period = 0.0
+        self.smoother: FixedLagOutputs | None = None
+        self._delayed: tuple[np.ndarray, np.ndarray] | None = None
+        self._aux = np.zeros(4)
+        self._result = HeaveResult(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, (), False, False)
+
+    def _start(self, dt: float) -> None:
+        p = self.params
+        self.dt = dt
+        n = int(round(p.window / dt))
+        self.buf = np.zeros((n, 4))
+        self.next_detect = n
+        self.smoother = FixedLagOutputs(int(round(p.smoother_lag / dt)), 2, 4)
+
+    @property
+    def delay(self) -> float:
+        """Lag of the delayed outputs [s] (the increment model's states refer to the start of
+        each step, one step more)."""
+        if self.smoother is None:
+            return 0.0
+        return (self.smoother.lag + (self.params.measurement == "increment")) * self.dt
+
+    def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
+        """Process one sample.
+
+        Parameters
+        ----------
+        acc : float or array_like
+            f_z, or (3,) f_b: specific force at the IMU [m/s², body] (``vertical="ned"``
+            needs all three).
+        roll, pitch : float
+            φ, θ at the IMU's time [rad].
+        dt : float
+            Step [s] (> 0, constant; a change restarts the observer).
+
+        Returns
+        -------
+        HeaveResult
+            A bad sample is not used (the observer coasts); ``valid`` is False and ``warning``
+            says why.
+        """
+        p = self.params
+        f = np.asarray(acc, dtype=float).reshape(-1)
+        if f.shape == (1,):
+            f = np.array([0.0, 0.0, f[0]])
+        elif f.shape != (3,):
+            f = np.full(3, math.nan)
+        roll, pitch = float(roll), float(pitch)
+        warning = _bad_sample(f, roll, pitch)
+        if warning is not None:
+            log.warning("heave observer: %s; coasting on the model", warning)
+        restarted = None
+        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
+            restarted = f"step size changed from {self.dt} s to {dt} s; observer restarted"
+            log.warning("heave observer: %s", restarted)
+            self.reset()
+        if self.dt is None:
+            self._start(dt)
+        good = warning is None
+        if good:
+            a_v = vertical_acceleration(f, roll, pitch, p.vertical)
+            self.last_angles = (roll, pitch)
+            self.angles = (self.angles + [(roll, pitch)])[-3:]
+        else:
+            a_v = None
+            roll, pitch = self.last_angles
+        self.k += 1
+        aux = np.array([roll, pitch, *backward_rate(self.angles, self.dt)])
+        warning = warning or restarted
+        if self.model is None:
+            self._buffer(a_v, roll, pitch)
+            if self.k >= self.next_detect and self._detect():
+                self._replay()
+                return self._finish(good and restarted is None, warning)
+            return replace(self._result, valid=False, warning=warning)
+        self._process(a_v, aux)
+        self._buffer(a_v, roll, pitch)
+        if self.k >= self.next_detect:
+            self._detect()
+        return self._finish(good and restarted is None, warning)
+
+    # ---- internals ---------------------------------------------------------------------------
+    def _buffer(self, a_v: float | None, roll: float, pitch: float) -> None:
+        """Store a sample for the spectrum; a bad one is replaced by the model's acceleration
+        (or the previous sample before the model exists)."""
+        if a_v is None:
+            if self.model is not None:
+                fill = float(-(self.model.omega**2) @ self.x[0:-1:2] + self.x[-1])
+            else:
+                fill = float(self.buf[(self.k - 2) % len(self.buf), 0]) if self.k > 1 else 0.0
+            row = (fill, roll, pitch, 0.0)
+        else:
+            row = (a_v, roll, pitch, 1.0)
+        self.buf[(self.k - 1) % len(self.buf)] = row
+
+    def _window(self) -> np.ndarray:
+        """The buffer, oldest first."""
+        return np.roll(self.buf, -(self.k % len(self.buf)), axis=0)
+
+    def _detect(self) -> bool:
+        """Steps 1-2 on the buffer and, if peaks were found, a new bank with the state carried."""
+        p = self.params
+        self.next_detect = self.k + max(1, int(round(p.peak_interval / self.dt)))
+        spectrum = acceleration_spectrum(self._window()[:, 0], self.dt)
+        modes = find_modes(spectrum, p.omega_min, p.omega_max, p.max_modes, p.min_separation, p.min_relative)
+        if len(modes) == 0:
+            log.warning("heave observer: no spectral peak in [%g, %g] rad/s; modes unchanged", p.omega_min, p.omega_max)
+            return False
+        self.peak_period = 2.0 * math.pi / float(modes.omega[np.argmax(modes.amplitude)])
+        new = build_bank(modes.omega, self.dt, p.mode_noise, p.offset_noise, p.acc_noise, p.discretisation,
+                         p.measurement)
+        if self.model is not None:
+            t = carry_map(self.model.omega, new.omega)
+            self.xp, self.x = t @ self.xp, t @ self.x
+            self.smoother.propagate(t)
+        self.model = new
+        return True
+
+    def _replay(self) -> None:
+        """Run the new observer over the buffered window (first detection only)."""
+        win = self._window()
+        self.xp = np.zeros(self.model.n)
+        if self.params.vertical == "paper":
+            self.xp[-1] = -G * math.cos(win[0, 1]) * math.cos(win[0, 2])
+        self.x = self.xp.copy()
+        self.prev = None
+        hist: list[tuple[float, float]] = []
+        for a_v, roll, pitch, good in win:
+            hist = (hist + [(roll, pitch)])[-3:]
+            self._process(a_v if good else None, np.array([roll, pitch, *backward_rate(hist, self.dt)]))
+
+    def _process(self, a_v: float | None, aux: np.ndarray) -> None:
+        """One Kalman step (steady-state gain) with the smoother; a missing measurement coasts.
+
+        ``"paper"``: the measurement is this sample, the prior refers to its time.
+        ``"increment"``: the measurement is the mean of the previous and this sample, the prior
+        refers to the previous sample's time.
+        """
+        m, sm = self.model, self.smoother
+        if m.measurement == "paper":
+            y, state_aux = a_v, aux
+        else:
+            if self.prev is None:                       # first sample: nothing to difference
+                self.prev = (a_v, aux)
+                return
+            prev_a, state_aux = self.prev
+            y = None if a_v is None or prev_a is None else 0.5 * (prev_a + a_v)
+            self.prev = (a_v, aux)
+        sm.push(m.heave_rows, self.xp, m.P, state_aux)
+        if y is None:
+            post, phi = self.xp, m.A
+            nxt = m.A @ post
+        else:
+            innovation = y - float(m.C @ self.xp)
+            post = self.xp + m.K * innovation
+            sm.correct(m.C, innovation, m.S)
+            nxt = m.A_bar @ post + m.J * y
+            phi = m.closed_loop
+        self._delayed = sm.pop()
+        sm.propagate(phi)
+        self.x = post if m.measurement == "paper" else nxt
+        self.xp = nxt if m.measurement == "increment" else m.A @ post
+        self._aux = aux
+
+    def _finish(self, good: bool, warning: str | None) -> HeaveResult:
+        p, m = self.params, self.model
+        roll, pitch, rr, pr = self._aux
+        rows = m.heave_rows @ self.x
+        heave, rate = float(rows[0]), float(rows[1])
+        ph, pr_ = point_heave(heave, rate, p.point, roll, pitch, rr, pr, p.transfer)
+        if self._delayed is not None:
+            (dh, dr), (droll, dpitch, drr, dpr) = self._delayed
+            dph, _ = point_heave(float(dh), float(dr), p.point, droll, dpitch, drr, dpr, p.transfer)
+            delayed = (float(dh), float(dr), dph, True)
+        else:
+            delayed = (0.0, 0.0, 0.0, False)
+        self._result = HeaveResult(
+            heave, rate, ph, pr_, delayed[0], delayed[1], delayed[2], self.delay, float(self.x[-1]),
+            len(m.omega), self.peak_period, tuple(float(w) for w in m.omega), good, delayed[3], warning,
+        )
+        return self._result
