@@ -11,8 +11,11 @@ For the filter's prior error e⁻_k = x_k − x̂_{k|k−1} and innovation ε_k 
 (Simon, *Optimal State Estimation*, 2006, section 9.2, in its innovation form). Only a few
 output rows c_s are needed (heave, heave rate), so each pending time s carries the row block
 W = c_s Cov(e⁻_s, e⁻_k) instead of a full covariance: O(lag·n²) per step, constant memory.
-A coasted step (no measurement) has K = 0; a change of the state dimension is a map T
-inserted into Φ (``propagate`` takes any (n_new, n_old) matrix).
+A coasted step (no measurement) has K = 0. When the model changes (the observer's mode set),
+the pending times are frozen at their estimates so far (:meth:`FixedLagOutputs.freeze`): the
+first innovations of a new model are not consistent with the old one's covariances, and
+propagating them through the change (exact only for a consistent model) corrupted the delayed
+heave by decimetres in tests with the paper's measurement model.
 
 Why not filterpy: ``filterpy.kalman.FixedLagSmoother`` keeps every smoothed state ever computed
 (memory grows without bound, filterpy issue #274), costs O(lag·n³) per step, and assumes a
@@ -55,6 +58,12 @@ class FixedLagOutputs:
         """Advance the pending rows by one step of the prior error: W ← W Φᵀ (Φ may change n)."""
         if self.rows is not None:
             self.rows = self.rows @ phi.T
+
+    def freeze(self, n: int) -> None:
+        """Stop correcting the pending times (they keep their estimates so far) and expect
+        states of dimension ``n`` from now on. Used when the model changes: innovations of the
+        new model, large while it settles, must not rewrite the estimates of the old one."""
+        self.rows = np.zeros((self.lag + 1, self.n_out, n))
 
     def push(self, rows: np.ndarray, prior: np.ndarray, cov: np.ndarray, aux: np.ndarray | None = None) -> None:
         """Start smoothing the current time (the oldest pending time, if ``lag`` + 1 are

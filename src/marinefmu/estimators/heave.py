@@ -424,7 +424,7 @@ class HeaveObserver:
         if self.model is not None:
             t = carry_map(self.model.omega, new.omega)
             self.xp, self.x = t @ self.xp, t @ self.x
-            self.smoother.propagate(t)
+            self.smoother.freeze(new.n)
         self.model = new
         return True
 
