@@ -22,7 +22,7 @@ def record():
 
 
 @pytest.mark.fmu
-@pytest.mark.parametrize("name", ["AttitudeEstimator", "DisplacementReconstructor", "GnssAccFusion", "CentreOfRotation"])
+@pytest.mark.parametrize("name", ["AttitudeEstimator", "DisplacementReconstructor", "GnssAccFusion", "CentreOfRotation", "HeaveObserver"])
 def test_validate(fmu_dir, name):
     assert validate_fmu(str(fmu_dir / f"{name}.fmu")) == []
 
@@ -74,6 +74,8 @@ def test_reconstructor_fmu_equals_in_process(fmu_dir, tmp_path, record):
     ("GnssAccFusion", {"r": 0.0}, "r = 0.0 is out of range"),
     ("CentreOfRotation", {"hp_cutoff": 0.0}, "hp_cutoff = 0.0 is out of range"),
     ("CentreOfRotation", {"acc_sigma": -1.0}, "acc_sigma = -1.0 is out of range"),
+    ("HeaveObserver", {"window": 20.0}, "window = 20.0 is out of range"),
+    ("HeaveObserver", {"max_modes": 0}, "max_modes = 0 is out of range"),
 ])
 def test_bad_parameters_are_logged_and_steps_discarded(fmu_dir, tmp_path, name, params, message):
     from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE

@@ -7,6 +7,8 @@ from typing import Any
 from ..estimators.attitude import INIT_CHOICES, AttitudeParams
 from ..estimators.centre_of_rotation import ANGLE_CHOICES as CR_ANGLE_CHOICES
 from ..estimators.centre_of_rotation import CentreOfRotationParams
+from ..estimators.heave import TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
+from ..estimators.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
 from ..estimators.gnss_fusion import ANTENNAS, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
 from ..estimators.reconstruction import TILT_CHOICES
 from ..estimators.sliding_reconstruction import SlidingParams
@@ -193,4 +195,61 @@ def cr_params(values: dict[str, Any]) -> CentreOfRotationParams:
         angles=v["angles"], hp_cutoff=v["hp_cutoff"], diff_window=v["diff_window"], centripetal=bool(v["centripetal"]),
         acc_sigma=v["acc_sigma"], acc_rw=v["acc_rw"], offset_rw=v["offset_rw"], offset_sigma0=v["offset_sigma0"],
         settle_time=v["settle_time"], sensor=(v["sensor.x"], v["sensor.y"], v["sensor.z"]),
+    )
+
+
+_HV = HeaveObserverParams()
+HEAVE_PARAMETERS: list[Variable] = [
+    real("window", _HV.window, "s", "Spectrum window, >= two periods of omega_min (4 pi/omega_min), <= 3600"),
+    real("peak_interval", _HV.peak_interval, "s", "Time between peak detections (paper 003: T = 15 s), (0, 3600]"),
+    Variable("max_modes", "integer", _HV.max_modes, "", "Most oscillator modes, 1..20"),
+    real("omega_min", _HV.omega_min, "rad/s", "Lowest frequency searched for peaks, (0, omega_max)"),
+    real("omega_max", _HV.omega_max, "rad/s", "Highest frequency searched for peaks, (omega_min, 20]"),
+    real("min_separation", _HV.min_separation, "rad/s", "Peaks closer than this to a higher one are dropped, (0, 2]"),
+    real("min_relative", _HV.min_relative, "", "Peaks lower than this fraction of the highest are dropped, [0, 1)"),
+    real("acc_noise", _HV.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 1]"),
+    real("mode_noise", _HV.mode_noise, "m2/s2", "Mode process-noise density per rad/s of mode frequency, (0, 1000]"),
+    real("offset_noise", _HV.offset_noise, "m/s2/sqrt(s)", "Random-walk density of the offset state (paper 003 eq. 7), (0, 10]"),
+    Variable("discretisation", "string", _HV.discretisation, "", f"Mode transition: one of {', '.join(DISCRETISATIONS)} (rotation matrix, or the paper's eq. 9)"),
+    Variable("measurement", "string", _HV.measurement, "", f"Measurement model: one of {', '.join(MEASUREMENTS)} (mean acceleration over the step, or the paper's y = Cx)"),
+    Variable("vertical", "string", _HV.vertical, "", f"Vertical acceleration: one of {', '.join(VERTICAL_CHOICES)} (tilt needs only acc.z; ned uses acc.x, acc.y too; paper is body f_z)"),
+    Variable("transfer", "string", _HV.transfer, "", f"Transfer to the point: one of {', '.join(TRANSFER_CHOICES)} (exact 3-D lever arm, or the paper's eqs. 10-11)"),
+    *vec("point", "xyz", 0.0, "m", "Monitoring point relative to the IMU, body frame"),
+    real("smoother_lag", _HV.smoother_lag, "s", "Delay of the delayed heave (fixed-lag smoother), [0, 120]"),
+]
+HEAVE_INPUTS: list[Variable] = [
+    real("acc.z", -9.80665, "m/s2", "Specific force along body z at the IMU"),
+    real("acc.x", 0.0, "m/s2", "Specific force along body x (used when vertical = ned)"),
+    real("acc.y", 0.0, "m/s2", "Specific force along body y (used when vertical = ned)"),
+    real("roll", 0.0, "rad", "Roll (ZYX Euler)"),
+    real("pitch", 0.0, "rad", "Pitch (ZYX Euler)"),
+]
+HEAVE_OUTPUTS: list[Variable] = [
+    real("heave", 0.0, "m", "Heave at the IMU, positive down, NED"),
+    real("heave_rate", 0.0, "m/s", "Heave rate at the IMU, positive down, NED"),
+    real("point.heave", 0.0, "m", "Heave at the monitoring point, positive down, NED"),
+    real("point.heave_rate", 0.0, "m/s", "Heave rate at the monitoring point, positive down, NED"),
+    real("delayed.heave", 0.0, "m", "Fixed-lag smoothed heave at the IMU for time - delayed.delay, positive down"),
+    real("delayed.heave_rate", 0.0, "m/s", "Fixed-lag smoothed heave rate at the IMU for time - delayed.delay"),
+    real("delayed.point.heave", 0.0, "m", "Fixed-lag smoothed heave at the point for time - delayed.delay"),
+    real("delayed.delay", 0.0, "s", "Delay of the delayed outputs"),
+    real("offset", 0.0, "m/s2", "Offset state: vertical accelerometer bias (paper 003 eq. 7)"),
+    real("peak_period", 0.0, "s", "Period of the highest peak of the position spectrum"),
+]
+HEAVE_DISCRETE: list[Variable] = [
+    Variable("modes", "integer", 0, "", "Number of oscillator modes (0 before the first spectrum)"),
+    Variable("valid", "boolean", False, "", "False until the first spectrum and on a rejected (NaN/Inf/absurd) sample"),
+    Variable("delayed.valid", "boolean", False, "", "The delayed outputs refer to a time the observer has run through"),
+]
+
+
+def heave_params(values: dict[str, Any]) -> HeaveObserverParams:
+    """HeaveObserverParams from FMI-named values."""
+    v = resolve(HEAVE_PARAMETERS, values, "HeaveObserver")
+    return HeaveObserverParams(
+        window=v["window"], peak_interval=v["peak_interval"], max_modes=v["max_modes"], omega_min=v["omega_min"],
+        omega_max=v["omega_max"], min_separation=v["min_separation"], min_relative=v["min_relative"],
+        acc_noise=v["acc_noise"], mode_noise=v["mode_noise"], offset_noise=v["offset_noise"],
+        discretisation=v["discretisation"], measurement=v["measurement"], vertical=v["vertical"],
+        transfer=v["transfer"], point=(v["point.x"], v["point.y"], v["point.z"]), smoother_lag=v["smoother_lag"],
     )

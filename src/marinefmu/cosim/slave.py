@@ -50,7 +50,7 @@ class SlaveIO:
     outputs : sequence of Variable
         Real outputs, in the order of the model's output list.
     boolean_outputs : sequence of Variable
-        Boolean outputs, in the order of the model's boolean list.
+        Discrete outputs (boolean or integer), in the order of the model's discrete list.
     inputs : sequence of Variable
         Inputs (real, integer or boolean), stored in :attr:`inputs` by name.
     """
@@ -61,7 +61,7 @@ class SlaveIO:
         self.params: dict[str, Any] = {v.name: v.default for v in parameters}
         self.inputs: dict[str, Any] = {v.name: v.default for v in inputs}
         self.real_out: list[float] = [float(v.default) for v in outputs]
-        self.bool_out: list[bool] = [bool(v.default) for v in boolean_outputs]
+        self.bool_out: list[Any] = [_CAST[v.kind](v.default) for v in boolean_outputs]
         self.start_time = 0.0
         #: Why the slave cannot step (refused parameter or failed step), else None.
         self.error: str | None = None
@@ -77,8 +77,8 @@ class SlaveIO:
             slave.register_variable(Real(v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
                                          description=_describe(v), getter=self._item_getter(self.real_out, i)), nested=False)
         for i, v in enumerate(boolean_outputs):
-            slave.register_variable(Boolean(v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
-                                            description=_describe(v), getter=self._item_getter(self.bool_out, i)), nested=False)
+            slave.register_variable(_FMI_TYPES[v.kind](v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
+                                                       description=_describe(v), getter=self._item_getter(self.bool_out, i)), nested=False)
 
     def _register(self, v: Variable, causality: Fmi2Causality, variability: Fmi2Variability, store: dict) -> None:
         cast = _CAST[v.kind]

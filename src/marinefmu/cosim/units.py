@@ -25,6 +25,7 @@ UNITS: dict[str, dict[str, int]] = {
     "m2": {"m": 2},
     "rad2": {"rad": 2},
     "m2/s3": {"m": 2, "s": -3},
+    "m2/s2": {"m": 2, "s": -2},
     "m2*s": {"m": 2, "s": 1},
     "m/s2/sqrt(s)": {},
     "m/sqrt(s)": {},

@@ -491,3 +491,40 @@ class HeaveObserver:
             len(m.omega), self.peak_period, tuple(float(w) for w in m.omega), good, delayed[3], warning,
         )
         return self._result
+
+    # ---- FMU state ---------------------------------------------------------------------------
+    def get_state(self) -> dict:
+        """JSON-serialisable internal state (the bank is rebuilt from its frequencies)."""
+        def arr(v: Any) -> Any:
+            return None if v is None else np.asarray(v).tolist()
+        return {
+            "dt": self.dt, "buf": arr(self.buf), "k": self.k, "next_detect": self.next_detect,
+            "omega": None if self.model is None else self.model.omega.tolist(), "xp": arr(self.xp), "x": arr(self.x),
+            "prev": None if self.prev is None else [self.prev[0], self.prev[1].tolist()],
+            "angles": [list(a) for a in self.angles], "last_angles": list(self.last_angles),
+            "peak_period": self.peak_period, "aux": self._aux.tolist(),
+            "delayed": None if self._delayed is None else [v.tolist() for v in self._delayed],
+            "smoother": None if self.smoother is None else self.smoother.get_state(), "result": self._result.__dict__,
+        }
+
+    def set_state(self, s: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        p = self.params
+        self.reset()
+        if s["dt"] is None:
+            return
+        self._start(float(s["dt"]))
+        self.buf = np.array(s["buf"], dtype=float)
+        self.k, self.next_detect = int(s["k"]), int(s["next_detect"])
+        if s["omega"] is not None:
+            self.model = build_bank(np.array(s["omega"]), self.dt, p.mode_noise, p.offset_noise, p.acc_noise,
+                                    p.discretisation, p.measurement)
+        self.xp, self.x = np.array(s["xp"], dtype=float), np.array(s["x"], dtype=float)
+        self.prev = None if s["prev"] is None else (s["prev"][0], np.array(s["prev"][1]))
+        self.angles = [tuple(a) for a in s["angles"]]
+        self.last_angles = tuple(s["last_angles"])
+        self.peak_period = float(s["peak_period"])
+        self._aux = np.array(s["aux"], dtype=float)
+        self._delayed = None if s["delayed"] is None else tuple(np.array(v) for v in s["delayed"])
+        self.smoother.set_state(s["smoother"])
+        self._result = HeaveResult(**{**s["result"], "omega": tuple(s["result"]["omega"])})

@@ -84,7 +84,7 @@ MEASUREMENTS = ("increment", "paper")
 
 @dataclass(frozen=True)
 class BankModel:
-    """Discrete model of the mode bank (eqs. 8-9) with its steady-state Kalman filter.
+    r"""Discrete model of the mode bank (eqs. 8-9) with its steady-state Kalman filter.
 
     The filter, for either measurement model (module docstring), is
 

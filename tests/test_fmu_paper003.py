@@ -1,0 +1,57 @@
+"""HeaveObserver FMU run by FMPy equals the in-process observer bit for bit (with a NaN sample),
+and saves/restores its state."""
+import math
+
+import numpy as np
+import pytest
+from conftest import DT, Driver
+
+from marinefmu.cosim.estimator_io import heave_params
+from marinefmu.estimators.heave import HeaveObserver
+
+OUTS = ["heave", "heave_rate", "point.heave", "point.heave_rate", "delayed.heave", "delayed.point.heave",
+        "delayed.delay", "offset", "peak_period"]
+PARAMS = {"window": 40.0, "omega_min": 0.35, "smoother_lag": 2.0, "point.x": 40.0, "point.z": -5.0}
+
+
+def _inputs(k):
+    t = (k + 1) * DT
+    return {"acc.x": 0.1 * math.sin(0.9 * t), "acc.y": 0.0, "acc.z": -9.80665 - 0.4 * math.cos(0.8 * t) - 0.1 * math.cos(1.7 * t),
+            "roll": 0.02 * math.sin(0.7 * t), "pitch": 0.03 * math.cos(0.8 * t)}
+
+
+@pytest.mark.fmu
+def test_heave_fmu_equals_in_process(fmu_dir, tmp_path):
+    f = Driver(fmu_dir / "HeaveObserver.fmu", tmp_path, "heave")
+    f.init(PARAMS)
+    obs = HeaveObserver(heave_params(PARAMS))
+    for k in range(5500):
+        inputs = _inputs(k)
+        if k == 5000:
+            inputs["acc.z"] = math.nan
+        status, reals, flags = f.step(k, inputs, OUTS, ("valid", "delayed.valid"))
+        r = obs.step((inputs["acc.x"], inputs["acc.y"], inputs["acc.z"]), inputs["roll"], inputs["pitch"], DT)
+        assert status in (0, None)
+        assert reals == [r.heave, r.heave_rate, r.point_heave, r.point_heave_rate, r.delayed_heave,
+                         r.delayed_point_heave, r.delay, r.offset, r.peak_period], k
+        assert flags == [r.valid, r.delayed_valid]
+        if k == 5000:
+            assert not flags[0] and all(np.isfinite(reals))
+    assert f.fmu.getInteger([f.vr["modes"].valueReference]) == [obs._result.modes] and obs._result.modes >= 2
+    assert all(flags)
+    f.close()
+
+
+@pytest.mark.fmu
+def test_heave_fmu_state_restore_repeats_the_run(fmu_dir, tmp_path):
+    f = Driver(fmu_dir / "HeaveObserver.fmu", tmp_path, "heave_state")
+    f.init(PARAMS)
+    for k in range(4200):
+        f.step(k, _inputs(k), OUTS)
+    state = f.fmu.getFMUstate()
+    first = [f.step(k, _inputs(k), OUTS)[1] for k in range(4200, 4300)]
+    f.fmu.setFMUstate(state)
+    again = [f.step(k, _inputs(k), OUTS)[1] for k in range(4200, 4300)]
+    assert again == first
+    f.fmu.freeFMUstate(state)
+    f.close()

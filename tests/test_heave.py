@@ -1,0 +1,194 @@
+"""Heave observer (paper 003): spectrum and peaks, the oscillator bank's steady-state gain
+against filterpy, the fixed-lag smoother against filterpy's RTS smoother, exact kernels
+against VesselMotion truth, accuracy against truth, the bias step, and bad input."""
+import math
+
+import numpy as np
+import pytest
+from filterpy.kalman import KalmanFilter, rts_smoother
+
+from marinefmu.errors import ParameterError
+from marinefmu.estimators.fixed_lag import FixedLagOutputs
+from marinefmu.estimators.heave import (
+    HeaveObserver, HeaveObserverParams, point_heave, vertical_acceleration,
+)
+from marinefmu.estimators.oscillator_bank import build_bank, carry_map
+from marinefmu.frames import G, body_to_euler_rates
+from marinefmu.sea.motion_model import VesselMotionParams, simulate_record, stack
+from marinefmu.sea.waves import SeaState, realise
+
+DT = 0.05
+IMU, ARM = (-5.0, 1.0, -3.0), (40.0, 0.0, -5.0)
+
+
+def _run(params, acc, roll, pitch, dt=DT):
+    obs = HeaveObserver(params)
+    out = np.array([[r.heave, r.point_heave, r.delayed_heave, r.valid, r.modes]
+                    for r in (obs.step(acc[k], roll[k], pitch[k], dt) for k in range(len(acc)))])
+    return out, obs
+
+
+@pytest.mark.parametrize("measurement", ["increment", "paper"])
+def test_exact_sum_of_sinusoids_is_recovered(measurement):
+    dt, w, amp, ph = 0.1, np.array([0.6, 1.1]), np.array([0.5, 0.2]), np.array([0.3, 1.0])
+    t = np.arange(1, 9001) * dt
+    z = (amp * np.cos(np.outer(t, w) + ph)).sum(axis=1)
+    acc = -(amp * w**2 * np.cos(np.outer(t, w) + ph)).sum(axis=1) - G
+    out, obs = _run(HeaveObserverParams(measurement=measurement), acc, 0 * t, 0 * t, dt)
+    assert np.all(np.abs(np.array(obs._result.omega) - w) < 2 * math.pi / 120.0)   # spectral resolution
+    settled = slice(3000, None)
+    assert np.sqrt(np.mean((out[settled, 0] - z[settled]) ** 2)) < 1e-3 * np.std(z)
+    lag = int(round(obs.delay / dt))
+    assert np.sqrt(np.mean((out[3000 + lag:, 2] - z[3000:len(z) - lag]) ** 2)) < 1e-3 * np.std(z)
+    assert not out[:1199, 3].any() and out[1200:, 3].all()       # valid from the first spectrum
+
+
+@pytest.mark.parametrize("measurement", ["increment", "paper"])
+def test_steady_state_gain_equals_filterpy_run_to_convergence(measurement):
+    m = build_bank(np.array([0.5, 0.9]), 0.05, 1e-2, 1e-2, 7e-3, "exact", measurement)
+    kf = KalmanFilter(dim_x=m.n, dim_z=1)
+    kf.F, kf.Q, kf.H, kf.R = m.A_bar, m.Q, m.C[None, :], np.array([[m.R]])
+    for _ in range(20000):
+        kf.predict()
+        kf.update(np.zeros((1, 1)))
+    np.testing.assert_allclose(kf.K[:, 0], m.K, rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(kf.P_prior, m.P, rtol=1e-6, atol=1e-14)
+
+
+def test_fixed_lag_smoother_equals_rts_on_data_up_to_now():
+    rng = np.random.default_rng(4)
+    m = build_bank(np.array([0.6, 1.0]), 0.1, 1e-2, 1e-3, 1e-2, "exact", "paper")
+    ys = rng.normal(size=300)
+    lag = 25
+    sm = FixedLagOutputs(lag, m.n)
+    xp, smoothed = np.zeros(m.n), {}
+    for k, y in enumerate(ys):
+        sm.push(np.eye(m.n), xp, m.P)
+        innovation = y - m.C @ xp
+        post = xp + m.K * innovation
+        sm.correct(m.C, innovation, m.S)
+        popped = sm.pop()
+        if popped is not None:
+            smoothed[k - lag] = popped[0]
+        sm.propagate(m.closed_loop)
+        xp = m.A @ post
+    for k in (150, 299):
+        kf = KalmanFilter(dim_x=m.n, dim_z=1)      # batch_filter moves the filter: a fresh one each time
+        kf.F, kf.Q, kf.H, kf.R = m.A, m.Q, m.C[None, :], np.array([[m.R]])
+        kf.x = np.zeros((m.n, 1))
+        kf.P = np.linalg.solve(m.A, np.linalg.solve(m.A, m.P - m.Q).T).T   # so that the first prior is P
+        xs, ps, _, _ = kf.batch_filter(ys[:k + 1, None])
+        xs_s, _, _, _ = rts_smoother(xs, ps, [m.A] * (k + 1), [m.Q] * (k + 1))
+        np.testing.assert_allclose(smoothed[k - lag], xs_s[k - lag, :, 0], atol=1e-9)
+
+
+def test_carry_map_keeps_heave_heave_rate_and_offset():
+    old = build_bank(np.array([0.4, 0.6, 0.9]), 0.05, 1e-2, 3e-4, 7e-4)
+    new = build_bank(np.array([0.62, 1.2]), 0.05, 1e-2, 3e-4, 7e-4)
+    t = carry_map(old.omega, new.omega)
+    x = np.random.default_rng(1).normal(size=old.n)
+    np.testing.assert_allclose(new.heave_rows @ (t @ x), old.heave_rows @ x, atol=1e-15)
+    assert (t @ x)[-1] == x[-1]
+
+
+@pytest.fixture(scope="module")
+def record():
+    flat = {"sea.hs": 1.0, "sea.tp": 6.0, "sea.seed": 3, "sea.heading": 0.75 * math.pi,
+            **{f"imu.{a}": v for a, v in zip("xyz", IMU)}, **{f"point.{a}": i + r for a, i, r in zip("xyz", IMU, ARM)}}
+    return simulate_record(VesselMotionParams.from_flat(flat), 1920.0, DT)
+
+
+def test_ned_vertical_acceleration_and_point_transfer_are_exact(record):
+    f, roll, pitch = stack(record, "truth.imu_f"), record["truth.roll"], record["truth.pitch"]
+    a_d = np.array([vertical_acceleration(f[k], roll[k], pitch[k], "ned") for k in range(0, len(f), 97)])
+    np.testing.assert_allclose(a_d, record["truth.imu_acc.d"][::97], atol=1e-9)
+    rate = stack(record, "truth.rate")
+    for k in range(100, len(f), 997):
+        rr, pr, _ = body_to_euler_rates([roll[k], pitch[k], record["truth.yaw"][k]], list(rate[k]))
+        d, v = point_heave(record["truth.imu.d"][k], record["truth.imu_vel.d"][k], ARM, roll[k], pitch[k], rr, pr)
+        assert d + ARM[2] == pytest.approx(record["truth.point.d"][k], abs=1e-9)
+        assert v == pytest.approx(record["truth.point_vel.d"][k], abs=1e-9)
+
+
+def _errors(record, out, obs, settle=120.0):
+    k0 = int(settle / DT)
+    lag = int(round(obs.delay / DT))
+    rms = lambda e: float(np.sqrt(np.mean(e**2)))  # noqa: E731
+    ti = record["truth.imu.d"][k0:] - record["truth.imu.d"][k0:].mean()
+    tp = record["truth.point.d"][k0:] - record["truth.point.d"][k0:].mean()
+    return (rms(out[k0:, 0] - ti), rms(out[k0:, 1] - tp), rms(out[k0 + lag:, 2] - ti[:len(ti) - lag]),
+            float(np.std(ti)), float(np.std(tp)))
+
+
+def test_heave_accuracy_short_swell_meets_the_goal(record):
+    """Hs 1 m, Tp 6 s, default MEMS noise, 30 min after 2 min: real-time heave at the IMU and at
+    a bow point 40 m away within max(2 cm, 2.5 %) and delayed heave within max(1 cm, 1 %).
+    (Longer periods do not meet these goals yet: README, paper 003.)"""
+    acc = stack(record, "imu.acc")
+    out, obs = _run(HeaveObserverParams(vertical="ned", point=ARM), acc, record["truth.roll"], record["truth.pitch"])
+    imu, pt, delayed, s_imu, s_pt = _errors(record, out, obs)
+    assert imu <= max(0.02, 0.025 * s_imu) and pt <= max(0.02, 0.025 * s_pt)
+    assert delayed <= max(0.01, 0.01 * s_imu)
+
+
+def test_bias_step_is_absorbed_by_the_offset(record):
+    """Paper section 3.2: +2 m/s² on the accelerometer from t = Δt. (A step in mid-run takes
+    longer than 60 s to absorb: README, paper 003.)"""
+    acc = stack(record, "imu.acc")
+    roll, pitch = record["truth.roll"], record["truth.pitch"]
+    ref, ref_obs = _run(HeaveObserverParams(), acc, roll, pitch)
+    for start in (1,):
+        biased = acc.copy()
+        biased[start:, 2] += 2.0
+        out, obs = _run(HeaveObserverParams(), biased, roll, pitch)
+        gained = obs._result.offset - ref_obs._result.offset
+        assert gained == pytest.approx(2.0 / (math.cos(roll[-1]) * math.cos(pitch[-1])), abs=0.01)
+        after = max(start, int(120 / DT)) + int(60 / DT)
+        assert np.sqrt(np.mean((out[after:, 0] - ref[after:, 0]) ** 2)) < 0.01
+
+
+def test_two_spectral_peaks_are_tracked_with_two_modes():
+    """Swell (Tp 14 s) plus wind sea (Tp 5 s) on a heave-following buoy."""
+    t = np.arange(1, int(900 / DT) + 1) * DT
+    z, a = np.zeros_like(t), np.zeros_like(t)
+    for hs, tp, stream in ((1.0, 14.0, 0), (1.5, 5.0, 1)):
+        f = realise(SeaState(hs=hs, tp=tp, seed=5), stream)
+        arg = np.outer(t, f.omega) + f.phase
+        z -= np.cos(arg) @ f.amplitude
+        a += np.cos(arg) @ (f.amplitude * f.omega**2)
+    rng = np.random.default_rng(2)
+    acc = a - G + 7e-4 / math.sqrt(DT) * rng.standard_normal(len(t))
+    out, obs = _run(HeaveObserverParams(), acc, 0 * t, 0 * t)
+    periods = 2 * math.pi / np.array(obs._result.omega)
+    assert obs._result.modes >= 2
+    assert np.min(np.abs(periods - 14.0)) < 0.15 * 14.0 and np.min(np.abs(periods - 5.0)) < 0.15 * 5.0
+    k0 = int(120 / DT)
+    assert np.corrcoef(out[k0:, 0], z[k0:])[0, 1] > 0.97     # measured 0.976: the 14 s swell limits it
+
+
+def test_bad_samples_coast_and_are_reported():
+    obs = HeaveObserver(HeaveObserverParams(window=60.0, omega_min=0.3))
+    t = np.arange(1, 2001) * 0.1
+    for k, tk in enumerate(t):
+        acc = -0.3 * math.cos(0.8 * tk) - G
+        r = obs.step(math.nan if k == 1500 else acc, 0.01, 0.02, 0.1)
+        if k == 1500:
+            assert not r.valid and "non-finite" in r.warning and math.isfinite(r.heave) and r.modes > 0
+        elif k > 600:
+            assert r.valid
+    assert not obs.step(-G, 2.0, 0.0, 0.1).valid                 # absurd roll
+    assert not obs.step([0.0, 0.0, 500.0], 0.0, 0.0, 0.1).valid  # absurd specific force
+
+
+@pytest.mark.parametrize("field,value,message", [
+    ("window", 20.0, "window = 20.0 is out of range"),
+    ("max_modes", 0, "max_modes = 0 is out of range"),
+    ("acc_noise", 0.0, "acc_noise = 0.0 is out of range"),
+    ("mode_noise", -1.0, "mode_noise = -1.0 is out of range"),
+    ("offset_noise", 0.0, "offset_noise = 0.0 is out of range"),
+    ("omega_min", 0.0, "omega_min = 0.0 is out of range"),
+    ("vertical", "up", "vertical = 'up' is not allowed"),
+])
+def test_bad_parameters_are_refused_by_name(field, value, message):
+    with pytest.raises(ParameterError, match=message):
+        HeaveObserverParams(**{field: value})
