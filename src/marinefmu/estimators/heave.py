@@ -50,7 +50,7 @@ from ..errors import ParameterError, check_choice, check_int, check_range, check
 from ..frames import G
 from .fixed_lag import FixedLagOutputs
 from .oscillator_bank import DISCRETISATIONS, MEASUREMENTS, BankModel, build_bank, carry_map
-from .samples import MAX_SPECIFIC_FORCE
+from .samples import force_beyond_limit
 from .wave_peaks import acceleration_spectrum, find_modes
 
 log = logging.getLogger(__name__)
@@ -223,9 +223,7 @@ def _bad_sample(acc: np.ndarray, roll: float, pitch: float) -> str | None:
         return "non-finite acceleration or angle sample"
     if max(abs(roll), abs(pitch)) > MAX_TILT:
         return f"roll or pitch beyond ±{MAX_TILT} rad"
-    if np.max(np.abs(acc)) > MAX_SPECIFIC_FORCE:
-        return f"specific force beyond {MAX_SPECIFIC_FORCE} m/s²"
-    return None
+    return force_beyond_limit(acc)
 
 
 # ---- stateful observer ----------------------------------------------------------------------
@@ -471,7 +469,7 @@ class HeaveObserver:
         self._delayed = sm.pop()
         sm.propagate(phi)
         self.x = post if m.measurement == "paper" else nxt
-        self.xp = nxt if m.measurement == "increment" else m.A @ post
+        self.xp = nxt
         self._aux = aux
 
     def _finish(self, good: bool, warning: str | None) -> HeaveResult:

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import control
 import numpy as np
@@ -132,7 +133,7 @@ class BankModel:
         """State dimension 2m + 1."""
         return len(self.C)
 
-    @property
+    @cached_property
     def heave_rows(self) -> np.ndarray:
         """(2, n) rows that sum the modes' positions and velocities: [Σz_j; Σż_j]."""
         rows = np.zeros((2, self.n))
@@ -140,7 +141,7 @@ class BankModel:
         rows[1, 1:-1:2] = 1.0
         return rows
 
-    @property
+    @cached_property
     def closed_loop(self) -> np.ndarray:
         """Ā(I − K C): transition of the prior error from one step to the next."""
         return self.A_bar @ (np.eye(self.n) - np.outer(self.K, self.C))
