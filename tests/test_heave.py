@@ -12,7 +12,8 @@ from marinefmu.estimators.fixed_lag import FixedLagOutputs
 from marinefmu.estimators.heave import (
     HeaveObserver, HeaveObserverParams, point_heave, vertical_acceleration,
 )
-from marinefmu.estimators.oscillator_bank import build_bank, carry_map
+from marinefmu.estimators.band_bank import build_band_bank, discretise, resonator
+from marinefmu.estimators.oscillator_bank import build_bank, carry_map, mode_noise_covariance, mode_transition
 from marinefmu.frames import G, body_to_euler_rates
 from marinefmu.sea.motion_model import VesselMotionParams, simulate_record, stack
 from marinefmu.sea.waves import SeaState, realise
@@ -28,18 +29,26 @@ def _run(params, acc, roll, pitch, dt=DT):
     return out, obs
 
 
-@pytest.mark.parametrize("measurement", ["increment", "paper"])
-def test_exact_sum_of_sinusoids_is_recovered(measurement):
+@pytest.mark.parametrize("model,measurement,tol", [
+    ("peaks", "increment", 1e-3), ("peaks", "paper", 1e-3),
+    # the band model's elements have a width, so a pure line is not its model: measured 8.1e-3
+    # (real time) and 3.7e-3 (delayed), the price of its accuracy on real, broad seas (README)
+    ("band", "increment", 1e-2),
+])
+def test_exact_sum_of_sinusoids_is_recovered(model, measurement, tol):
     dt, w, amp, ph = 0.1, np.array([0.6, 1.1]), np.array([0.5, 0.2]), np.array([0.3, 1.0])
     t = np.arange(1, 9001) * dt
     z = (amp * np.cos(np.outer(t, w) + ph)).sum(axis=1)
     acc = -(amp * w**2 * np.cos(np.outer(t, w) + ph)).sum(axis=1) - G
-    out, obs = _run(HeaveObserverParams(measurement=measurement), acc, 0 * t, 0 * t, dt)
-    assert np.all(np.abs(np.array(obs._result.omega) - w) < 2 * math.pi / 120.0)   # spectral resolution
+    out, obs = _run(HeaveObserverParams(model=model, measurement=measurement), acc, 0 * t, 0 * t, dt)
+    resolution = 2 * math.pi / 120.0
+    if model == "peaks":
+        assert np.all(np.abs(np.array(obs._result.omega) - w) < resolution)
+    assert abs(2 * math.pi / obs._result.peak_period - w[0]) < resolution
     settled = slice(3000, None)
-    assert np.sqrt(np.mean((out[settled, 0] - z[settled]) ** 2)) < 1e-3 * np.std(z)
+    assert np.sqrt(np.mean((out[settled, 0] - z[settled]) ** 2)) < tol * np.std(z)
     lag = int(round(obs.delay / dt))
-    assert np.sqrt(np.mean((out[3000 + lag:, 2] - z[3000:len(z) - lag]) ** 2)) < 1e-3 * np.std(z)
+    assert np.sqrt(np.mean((out[3000 + lag:, 2] - z[3000:len(z) - lag]) ** 2)) < tol * np.std(z)
     assert not out[:1199, 3].any() and out[1200:, 3].all()       # valid from the first spectrum
 
 
@@ -91,11 +100,44 @@ def test_carry_map_keeps_heave_heave_rate_and_offset():
     assert (t @ x)[-1] == x[-1]
 
 
-@pytest.fixture(scope="module")
-def record():
-    flat = {"sea.hs": 1.0, "sea.tp": 6.0, "sea.seed": 3, "sea.heading": 0.75 * math.pi,
+def _record(hs, tp):
+    flat = {"sea.hs": hs, "sea.tp": tp, "sea.seed": 3, "sea.heading": 0.75 * math.pi,
             **{f"imu.{a}": v for a, v in zip("xyz", IMU)}, **{f"point.{a}": i + r for a, i, r in zip("xyz", IMU, ARM)}}
     return simulate_record(VesselMotionParams.from_flat(flat), 1920.0, DT)
+
+
+def test_van_loan_discretisation_equals_the_closed_form_oscillator():
+    """A one-stage undamped band element is the paper's mode: its Van Loan discretisation
+    equals the rotation transition and the closed-form process noise."""
+    a_c, g = resonator(0.7, 0.0, 1)
+    a_d, q_d = discretise(a_c, g, 3e-3, 0.05)
+    np.testing.assert_allclose(a_d, mode_transition(0.7, 0.05), atol=1e-13)
+    np.testing.assert_allclose(q_d, mode_noise_covariance(0.7, 0.05, 3e-3), rtol=1e-9, atol=1e-18)
+
+
+def test_band_element_has_the_requested_heave_variance_and_no_heave_at_low_frequency():
+    m = build_band_bank(np.array([0.5]), np.array([0.04]), 0.05, 0.1, 3, 1e-4, 7e-4)
+    p = np.zeros_like(m.Q)
+    for _ in range(200000 // 50):          # stationary covariance of the element (offset excluded)
+        p = m.A @ p @ m.A.T + m.Q
+        p[-1, -1] = 0.0
+    assert m.heave_rows[0] @ p @ m.heave_rows[0] == pytest.approx(0.04, rel=1e-3)
+    a_c, g = resonator(0.5, 0.1, 3)        # heave response to the driving noise falls as ω² at 0
+    h = [abs(np.linalg.solve(1j * w * np.eye(6) - a_c, g)[-2, 0]) for w in (1e-3, 2e-3)]
+    assert h[1] / h[0] == pytest.approx(4.0, rel=1e-3)
+
+
+def test_carry_map_of_band_elements_keeps_heave_and_rate():
+    old = build_band_bank(np.array([0.4, 0.5, 0.6]), np.array([0.1, 0.2, 0.1]), 0.05, 0.1, 3, 1e-4, 7e-4)
+    new = build_band_bank(np.array([0.45, 0.6]), np.array([0.2, 0.1]), 0.05, 0.1, 3, 1e-4, 7e-4)
+    t = carry_map(old.omega, new.omega, new.block)
+    x = np.random.default_rng(1).normal(size=old.n)
+    np.testing.assert_allclose(new.heave_rows @ (t @ x), old.heave_rows @ x, atol=1e-14)
+
+
+@pytest.fixture(scope="module")
+def record():
+    return _record(1.0, 6.0)
 
 
 def test_ned_vertical_acceleration_and_point_transfer_are_exact(record):
@@ -120,13 +162,20 @@ def _errors(record, out, obs, settle=120.0):
             float(np.std(ti)), float(np.std(tp)))
 
 
-def test_heave_accuracy_short_swell_meets_the_goal(record):
-    """Hs 1 m, Tp 6 s, default MEMS noise, 30 min after 2 min: real-time heave at the IMU and at
-    a bow point 40 m away within max(2 cm, 2.5 %) and delayed heave within max(1 cm, 1 %).
-    (Longer periods do not meet these goals yet: README, paper 003.)"""
-    acc = stack(record, "imu.acc")
-    out, obs = _run(HeaveObserverParams(vertical="ned", point=ARM), acc, record["truth.roll"], record["truth.pitch"])
-    imu, pt, delayed, s_imu, s_pt = _errors(record, out, obs)
+@pytest.mark.parametrize("hs,tp", [
+    (1.0, 6.0),        # measured 0.29 / 0.29 / 0.15 cm (goals 2 / 2 / 1)
+    (2.5, 9.0),        # measured 1.19 / 1.19 / 0.50 cm (goals 2 / 2 / 1)
+    (1.0, 14.0),       # measured 1.98 / 1.98 / 0.91 cm (goals 2 / 2 / 1): the band's edge
+    pytest.param(4.0, 14.0, marks=pytest.mark.xfail(strict=True, reason=(
+        "goal not met: measured 3.64 / 3.68 / 1.99 cm against 2.28 / 2.72 / 1.0 (README, paper 003)"))),
+])
+def test_heave_accuracy_meets_the_goal(hs, tp, record):
+    """VesselMotion JONSWAP sea, default MEMS noise, 30 min after 2 min: real-time heave at the
+    IMU and at a bow point 40 m away within max(2 cm, 2.5 % of the heave std), delayed heave
+    within max(1 cm, 1 %) (issue goals; commercial units state 5 cm or 5 %)."""
+    rec = record if (hs, tp) == (1.0, 6.0) else _record(hs, tp)
+    out, obs = _run(HeaveObserverParams(point=ARM), stack(rec, "imu.acc"), rec["truth.roll"], rec["truth.pitch"])
+    imu, pt, delayed, s_imu, s_pt = _errors(rec, out, obs)
     assert imu <= max(0.02, 0.025 * s_imu) and pt <= max(0.02, 0.025 * s_pt)
     assert delayed <= max(0.01, 0.01 * s_imu)
 
@@ -142,13 +191,15 @@ def test_bias_step_is_absorbed_by_the_offset(record):
         biased[start:, 2] += 2.0
         out, obs = _run(HeaveObserverParams(), biased, roll, pitch)
         gained = obs._result.offset - ref_obs._result.offset
-        assert gained == pytest.approx(2.0 / (math.cos(roll[-1]) * math.cos(pitch[-1])), abs=0.01)
+        assert gained == pytest.approx(2.0 * math.cos(roll[-1]) * math.cos(pitch[-1]), abs=0.01)   # vertical part
         after = max(start, int(120 / DT)) + int(60 / DT)
         assert np.sqrt(np.mean((out[after:, 0] - ref[after:, 0]) ** 2)) < 0.01
 
 
-def test_two_spectral_peaks_are_tracked_with_two_modes():
-    """Swell (Tp 14 s) plus wind sea (Tp 5 s) on a heave-following buoy."""
+@pytest.mark.parametrize("model,corr", [("peaks", 0.98), ("band", 0.99)])   # measured 0.987, 0.995
+def test_two_spectral_peaks_are_tracked(model, corr):
+    """Swell (Tp 14 s) plus wind sea (Tp 5 s) on a heave-following buoy: the paper's model puts
+    a mode on each peak; both models track heave."""
     t = np.arange(1, int(900 / DT) + 1) * DT
     z, a = np.zeros_like(t), np.zeros_like(t)
     for hs, tp, stream in ((1.0, 14.0, 0), (1.5, 5.0, 1)):
@@ -158,12 +209,13 @@ def test_two_spectral_peaks_are_tracked_with_two_modes():
         a += np.cos(arg) @ (f.amplitude * f.omega**2)
     rng = np.random.default_rng(2)
     acc = a - G + 7e-4 / math.sqrt(DT) * rng.standard_normal(len(t))
-    out, obs = _run(HeaveObserverParams(), acc, 0 * t, 0 * t)
-    periods = 2 * math.pi / np.array(obs._result.omega)
-    assert obs._result.modes >= 2
-    assert np.min(np.abs(periods - 14.0)) < 0.15 * 14.0 and np.min(np.abs(periods - 5.0)) < 0.15 * 5.0
+    out, obs = _run(HeaveObserverParams(model=model), acc, 0 * t, 0 * t)
+    if model == "peaks":
+        periods = 2 * math.pi / np.array(obs._result.omega)
+        assert obs._result.modes >= 2
+        assert np.min(np.abs(periods - 14.0)) < 0.15 * 14.0 and np.min(np.abs(periods - 5.0)) < 0.15 * 5.0
     k0 = int(120 / DT)
-    assert np.corrcoef(out[k0:, 0], z[k0:])[0, 1] > 0.97     # measured 0.976: the 14 s swell limits it
+    assert np.corrcoef(out[k0:, 0], z[k0:])[0, 1] > corr
 
 
 def test_bad_samples_coast_and_are_reported():

@@ -7,7 +7,7 @@ from typing import Any
 from ..estimators.attitude import INIT_CHOICES, AttitudeParams
 from ..estimators.centre_of_rotation import ANGLE_CHOICES as CR_ANGLE_CHOICES
 from ..estimators.centre_of_rotation import CentreOfRotationParams
-from ..estimators.heave import TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
+from ..estimators.heave import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
 from ..estimators.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
 from ..estimators.gnss_fusion import ANTENNAS, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
 from ..estimators.reconstruction import TILT_CHOICES
@@ -202,7 +202,12 @@ _HV = HeaveObserverParams()
 HEAVE_PARAMETERS: list[Variable] = [
     real("window", _HV.window, "s", "Spectrum window, >= two periods of omega_min (4 pi/omega_min), <= 3600"),
     real("peak_interval", _HV.peak_interval, "s", "Time between peak detections (paper 003: T = 15 s), (0, 3600]"),
-    Variable("max_modes", "integer", _HV.max_modes, "", "Most oscillator modes, 1..20"),
+    Variable("model", "string", _HV.model, "", f"Observer model: one of {', '.join(MODEL_CHOICES)} (spectrum-weighted comb of band-pass elements, or the paper's undamped modes at the peaks)"),
+    Variable("max_modes", "integer", _HV.max_modes, "", "Most oscillator modes (model = peaks), 1..20"),
+    Variable("elements", "integer", _HV.elements, "", "Grid size of the band model, 2..100"),
+    real("damping", _HV.damping, "", "Damping ratio of the band elements' stages, (0, 1]"),
+    Variable("stages", "integer", _HV.stages, "", "Cascaded oscillators per band element, 1..4"),
+    real("spectrum_floor", _HV.spectrum_floor, "", "Band elements below this fraction of the highest heave density are left out, [0, 1)"),
     real("omega_min", _HV.omega_min, "rad/s", "Lowest frequency searched for peaks, (0, omega_max)"),
     real("omega_max", _HV.omega_max, "rad/s", "Highest frequency searched for peaks, (omega_min, 20]"),
     real("min_separation", _HV.min_separation, "rad/s", "Peaks closer than this to a higher one are dropped, (0, 2]"),
@@ -212,15 +217,15 @@ HEAVE_PARAMETERS: list[Variable] = [
     real("offset_noise", _HV.offset_noise, "m/s2/sqrt(s)", "Random-walk density of the offset state (paper 003 eq. 7), (0, 10]"),
     Variable("discretisation", "string", _HV.discretisation, "", f"Mode transition: one of {', '.join(DISCRETISATIONS)} (rotation matrix, or the paper's eq. 9)"),
     Variable("measurement", "string", _HV.measurement, "", f"Measurement model: one of {', '.join(MEASUREMENTS)} (mean acceleration over the step, or the paper's y = Cx)"),
-    Variable("vertical", "string", _HV.vertical, "", f"Vertical acceleration: one of {', '.join(VERTICAL_CHOICES)} (tilt needs only acc.z; ned uses acc.x, acc.y too; paper is body f_z)"),
+    Variable("vertical", "string", _HV.vertical, "", f"Vertical acceleration: one of {', '.join(VERTICAL_CHOICES)} (ned, exact, needs acc.x and acc.y connected; tilt needs only acc.z; paper is body f_z)"),
     Variable("transfer", "string", _HV.transfer, "", f"Transfer to the point: one of {', '.join(TRANSFER_CHOICES)} (exact 3-D lever arm, or the paper's eqs. 10-11)"),
     *vec("point", "xyz", 0.0, "m", "Monitoring point relative to the IMU, body frame"),
     real("smoother_lag", _HV.smoother_lag, "s", "Delay of the delayed heave (fixed-lag smoother), [0, 120]"),
 ]
 HEAVE_INPUTS: list[Variable] = [
     real("acc.z", -9.80665, "m/s2", "Specific force along body z at the IMU"),
-    real("acc.x", 0.0, "m/s2", "Specific force along body x (used when vertical = ned)"),
-    real("acc.y", 0.0, "m/s2", "Specific force along body y (used when vertical = ned)"),
+    real("acc.x", 0.0, "m/s2", "Specific force along body x (vertical = ned, the default: connect it)"),
+    real("acc.y", 0.0, "m/s2", "Specific force along body y (vertical = ned, the default: connect it)"),
     real("roll", 0.0, "rad", "Roll (ZYX Euler)"),
     real("pitch", 0.0, "rad", "Pitch (ZYX Euler)"),
 ]
@@ -237,7 +242,7 @@ HEAVE_OUTPUTS: list[Variable] = [
     real("peak_period", 0.0, "s", "Period of the highest peak of the position spectrum"),
 ]
 HEAVE_DISCRETE: list[Variable] = [
-    Variable("modes", "integer", 0, "", "Number of oscillator modes (0 before the first spectrum)"),
+    Variable("modes", "integer", 0, "", "Number of oscillator modes or band elements (0 before the first spectrum)"),
     Variable("valid", "boolean", False, "", "False until the first spectrum and on a rejected (NaN/Inf/absurd) sample"),
     Variable("delayed.valid", "boolean", False, "", "The delayed outputs refer to a time the observer has run through"),
 ]
@@ -249,7 +254,8 @@ def heave_params(values: dict[str, Any]) -> HeaveObserverParams:
     return HeaveObserverParams(
         window=v["window"], peak_interval=v["peak_interval"], max_modes=v["max_modes"], omega_min=v["omega_min"],
         omega_max=v["omega_max"], min_separation=v["min_separation"], min_relative=v["min_relative"],
-        acc_noise=v["acc_noise"], mode_noise=v["mode_noise"], offset_noise=v["offset_noise"],
+        model=v["model"], elements=v["elements"], damping=v["damping"], stages=v["stages"],
+        spectrum_floor=v["spectrum_floor"], acc_noise=v["acc_noise"], mode_noise=v["mode_noise"], offset_noise=v["offset_noise"],
         discretisation=v["discretisation"], measurement=v["measurement"], vertical=v["vertical"],
         transfer=v["transfer"], point=(v["point.x"], v["point.y"], v["point.z"]), smoother_lag=v["smoother_lag"],
     )

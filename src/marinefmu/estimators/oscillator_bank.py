@@ -98,6 +98,9 @@ class BankModel:
     ----------
     omega : numpy.ndarray
         (m,) mode frequencies [rad/s].
+    block : int
+        States per mode: 2 for an oscillator (z, ż), 2·stages for a band element whose last
+        two states are its heave and heave rate.
     measurement : str
         ``"increment"`` or ``"paper"``.
     A, Q : numpy.ndarray
@@ -117,6 +120,7 @@ class BankModel:
     """
 
     omega: np.ndarray
+    block: int
     measurement: str
     A: np.ndarray
     Q: np.ndarray
@@ -137,8 +141,8 @@ class BankModel:
     def heave_rows(self) -> np.ndarray:
         """(2, n) rows that sum the modes' positions and velocities: [Σz_j; Σż_j]."""
         rows = np.zeros((2, self.n))
-        rows[0, 0:-1:2] = 1.0
-        rows[1, 1:-1:2] = 1.0
+        rows[0, self.block - 2:-1:self.block] = 1.0
+        rows[1, self.block - 1:-1:self.block] = 1.0
         return rows
 
     @cached_property
@@ -180,7 +184,7 @@ def bank_matrices(omega: np.ndarray, dt: float, mode_noise: float, offset_noise:
 
 def build_bank(omega: np.ndarray, dt: float, mode_noise: float, offset_noise: float, acc_noise: float,
                discretisation: str = "exact", measurement: str = "increment") -> BankModel:
-    """The mode bank with its steady-state gain (python-control ``dlqe``).
+    """The paper's mode bank with its steady-state gain (python-control ``dlqe``).
 
     Parameters
     ----------
@@ -195,12 +199,37 @@ def build_bank(omega: np.ndarray, dt: float, mode_noise: float, offset_noise: fl
     """
     omega = np.asarray(omega, dtype=float)
     a, q, c = bank_matrices(omega, dt, mode_noise, offset_noise, discretisation)
+    return steady_state_filter(omega, 2, a, q, c, dt, acc_noise, measurement)
+
+
+def steady_state_filter(omega: np.ndarray, block: int, a: np.ndarray, q: np.ndarray, c: np.ndarray, dt: float,
+                        acc_noise: float, measurement: str) -> BankModel:
+    """The Kalman filter of a bank (modes of ``block`` states, then the offset) for either
+    measurement model, with its steady-state gain from ``dlqe``.
+
+    Parameters
+    ----------
+    omega : numpy.ndarray
+        (m,) mode frequencies [rad/s].
+    block : int
+        States per mode; the last two of each are its heave and heave rate.
+    a, q : numpy.ndarray
+        (n, n) discrete transition and process-noise covariance, n = block·m + 1.
+    c : numpy.ndarray
+        (n,) the paper's measurement row: the modes' acceleration plus the offset.
+    dt : float
+        Step [s].
+    acc_noise : float
+        Accelerometer white-noise density N [m/s²/√Hz].
+    measurement : str
+        ``"increment"`` or ``"paper"`` (module docstring).
+    """
     n = len(c)
     if measurement == "paper":
         a_bar, j, r = a, np.zeros(n), acc_noise**2 / dt
     else:
         hv = np.zeros(n)
-        hv[1:-1:2] = 1.0
+        hv[block - 1:-1:block] = 1.0
         c = hv @ (a - np.eye(n)) / dt
         c[-1] = 1.0
         cross = q @ hv / dt                                # Cov(w_k, e_k)
@@ -211,20 +240,21 @@ def build_bank(omega: np.ndarray, dt: float, mode_noise: float, offset_noise: fl
     _, p, _ = control.dlqe(a_bar, np.eye(n), c[None, :], q, np.array([[r]]))
     p = 0.5 * (np.asarray(p) + np.asarray(p).T)
     s = float(c @ p @ c + r)
-    return BankModel(omega, measurement, a, q, a_bar, j, c, r, p @ c / s, p, s)
+    return BankModel(omega, block, measurement, a, q, a_bar, j, c, r, p @ c / s, p, s)
 
 
-def carry_map(old: np.ndarray, new: np.ndarray) -> np.ndarray:
-    """(2m_new + 1, 2m_old + 1) map of the state across a change of the mode set.
+def carry_map(old: np.ndarray, new: np.ndarray, block: int = 2) -> np.ndarray:
+    """(block·m_new + 1, block·m_old + 1) map of the state across a change of the mode set.
 
-    Every old mode's (z, ż) goes to the nearest new mode in frequency (a persisting mode keeps
+    Every old mode's states go to the nearest new mode in frequency (a persisting mode keeps
     its state; a vanished mode's state joins its nearest neighbour), the offset to the offset.
     So Σz_j, Σż_j and the offset, hence heave, heave rate and offset, are continuous across the
     change: no transient in the output. New modes with no old mode nearby start at zero.
     """
-    t = np.zeros((2 * len(new) + 1, 2 * len(old) + 1))
+    t = np.zeros((block * len(new) + 1, block * len(old) + 1))
+    eye = np.eye(block)
     for i, w in enumerate(old):
         j = int(np.argmin(np.abs(np.asarray(new) - w)))
-        t[2 * j, 2 * i] = t[2 * j + 1, 2 * i + 1] = 1.0
+        t[block * j:block * (j + 1), block * i:block * (i + 1)] += eye
     t[-1, -1] = 1.0
     return t

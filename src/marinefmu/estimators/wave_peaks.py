@@ -39,12 +39,16 @@ class Spectrum:
         (M,) A(ω) = Ä(ω)/ω² [m] (eq. 2).
     position_phase : numpy.ndarray
         (M,) φ(ω) = φ̈(ω) − π [rad], phase at the window's last sample (eq. 2).
+    acc_density : numpy.ndarray
+        (M,) one-sided power spectral density of the acceleration [(m/s²)²/(rad/s)] (Hann
+        periodogram: Σ acc_density·Δω is the window's variance).
     """
 
     omega: np.ndarray
     acc_amplitude: np.ndarray
     position_amplitude: np.ndarray
     position_phase: np.ndarray
+    acc_density: np.ndarray
 
     @property
     def resolution(self) -> float:
@@ -75,7 +79,8 @@ def acceleration_spectrum(acc: np.ndarray, dt: float) -> Spectrum:
     amp = 2.0 * np.abs(spec) / taper.sum()
     # phase referred to the last sample (t = (n−1)·dt from the window start)
     phase = np.angle(spec) + omega * (n - 1) * dt
-    return Spectrum(omega, amp, amp / omega**2, np.angle(np.exp(1j * (phase - math.pi))))
+    density = np.abs(spec) ** 2 * dt / (math.pi * float(np.sum(taper**2)))
+    return Spectrum(omega, amp, amp / omega**2, np.angle(np.exp(1j * (phase - math.pi))), density)
 
 
 @dataclass(frozen=True)
