@@ -244,3 +244,21 @@ def test_bad_samples_coast_and_are_reported():
 def test_bad_parameters_are_refused_by_name(field, value, message):
     with pytest.raises(ParameterError, match=message):
         HeaveObserverParams(**{field: value})
+
+
+def test_highpass_baseline_has_the_analytic_response_and_refuses_a_bad_cutoff():
+    """The classical baseline beside the observer (README): its gain and phase on a sinusoid
+    are those of s²/B₄(s) (the bilinear transform warps ω by (ωΔt)²/12 = 8e-5 at ωΔt = 0.03)."""
+    from scipy import signal
+
+    from marinefmu.estimators.integration import highpass_double_integration
+    dt, w, wc = 0.05, 0.6, 0.1
+    t = np.arange(0, 3000, dt)
+    h = highpass_double_integration(-w**2 * np.cos(w * t), dt, wc)
+    _, den = signal.butter(4, wc, btype="highpass", analog=True)
+    resp = -(w**2) * (1j * w) ** 2 / np.polyval(den, 1j * w)    # s²/B(s) at jω on −ω²cos ωt: 1 if ideal
+    expected = np.real(resp * np.exp(1j * w * t))
+    np.testing.assert_allclose(h[30000:], expected[30000:], atol=3e-4)     # measured 1.2e-4
+    assert abs(resp) < 1.0 and np.angle(resp) > 0.05          # the long-wave error it makes
+    with pytest.raises(ParameterError, match="cutoff = 0.0 is out of range"):
+        highpass_double_integration(np.zeros(10), dt, 0.0)

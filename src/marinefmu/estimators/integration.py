@@ -108,3 +108,42 @@ def integrate_frequency(acc: np.ndarray, dt: float, band: tuple[float, float] | 
     vel = np.fft.irfft(spec * jw.reshape(shape), n=n, axis=0)  # eq. 9, 11
     disp = np.fft.irfft(spec * (jw ** 2).reshape(shape), n=n, axis=0)  # eq. 10, 12
     return vel, disp
+
+
+def highpass_double_integration(acc: np.ndarray, dt: float, cutoff: float, order: int = 4) -> np.ndarray:
+    """Causal heave from acceleration by high-pass filtered double integration, the classical
+    design of motion reference units (the baseline of paper 003's checks).
+
+    The continuous filter is 1/s² (double integration) times an ``order``-th order Butterworth
+    high pass at ``cutoff``, H(s) = s^{order−2}/B(s), proper and stable for order ≥ 2, made
+    discrete by the bilinear transform (``scipy.signal.bilinear``) and run by
+    ``scipy.signal.lfilter`` from rest. It has no drift, but its phase lead and gain loss near
+    the cutoff are errors on long waves.
+
+    Parameters
+    ----------
+    acc : numpy.ndarray
+        (N,) vertical acceleration [m/s²], gravity removed, uniformly sampled.
+    dt : float
+        Sample interval [s].
+    cutoff : float
+        High-pass corner ω_c [rad/s], below the wave band, (0, π/dt).
+    order : int
+        Butterworth order, 2..8.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) heave [m], same sign convention as ``acc``.
+    """
+    from scipy import signal
+
+    check_range("cutoff", cutoff, lo=0.0, hi=math.pi / dt, lo_open=True, hi_open=True, unit="rad/s")
+    if not isinstance(order, int) or not 2 <= order <= 8:
+        raise ParameterError(f"order = {order!r} is out of range: an integer 2..8")
+    _, den = signal.butter(order, cutoff, btype="highpass", analog=True)
+    num = np.zeros(order - 1)
+    num[0] = 1.0                                          # s^(order−2)
+    b, a = signal.bilinear(num, den, fs=1.0 / dt)
+    x = np.asarray(acc, dtype=float)
+    return signal.lfilter(b, a, x)
