@@ -18,9 +18,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import integrate
+from scipy import integrate, signal
 
-from ..errors import ParameterError, ShapeError, check_choice, check_range
+from ..errors import ParameterError, ShapeError, check_choice, check_int, check_range
 
 TIME_METHODS = ("trapezoid", "simpson", "simpson_eq6")
 
@@ -136,11 +136,8 @@ def highpass_double_integration(acc: np.ndarray, dt: float, cutoff: float, order
     numpy.ndarray
         (N,) heave [m], same sign convention as ``acc``.
     """
-    from scipy import signal
-
     check_range("cutoff", cutoff, lo=0.0, hi=math.pi / dt, lo_open=True, hi_open=True, unit="rad/s")
-    if not isinstance(order, int) or not 2 <= order <= 8:
-        raise ParameterError(f"order = {order!r} is out of range: an integer 2..8")
+    check_int("order", order, lo=2, hi=8)
     _, den = signal.butter(order, cutoff, btype="highpass", analog=True)
     num = np.zeros(order - 1)
     num[0] = 1.0                                          # s^(order−2)
