@@ -93,7 +93,7 @@ def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float) -> tuple[n
     spectrum : Spectrum
         From :func:`~.wave_peaks.acceleration_spectrum`.
     grid : numpy.ndarray
-        (M,) candidate frequencies [rad/s], ascending.
+        (M,) candidate frequencies [rad/s], ascending, M ≥ 2 (:func:`band_grid`).
     floor : float
         Elements whose heave density is below ``floor`` times the highest are left out.
 
@@ -103,9 +103,8 @@ def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float) -> tuple[n
         Frequencies [rad/s] and heave variances [m²] of the elements kept (possibly none).
     """
     s_z = np.interp(grid, spectrum.omega, spectrum.acc_density) / grid**4
-    variance = s_z * np.gradient(grid) if len(grid) > 1 else s_z
-    keep = (s_z > 0.0) & (s_z >= floor * s_z.max()) if len(grid) else np.zeros(0, bool)
-    return grid[keep], variance[keep]
+    keep = (s_z > 0.0) & (s_z >= floor * s_z.max())
+    return grid[keep], (s_z * np.gradient(grid))[keep]
 
 
 def build_band_bank(omega: np.ndarray, variance: np.ndarray, dt: float, damping: float, stages: int,
