@@ -9,7 +9,7 @@ from ..estimators.centre_of_rotation import ANGLE_CHOICES as CR_ANGLE_CHOICES
 from ..estimators.centre_of_rotation import CentreOfRotationParams
 from ..estimators.heave import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
 from ..estimators.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
-from ..estimators.gnss_fusion import ANTENNAS, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
+from ..estimators.gnss_fusion import ANTENNAS, COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
 from ..estimators.reconstruction import TILT_CHOICES
 from ..estimators.sliding_reconstruction import SlidingParams
 from ..interface import Variable, real, resolve, vec
@@ -113,6 +113,9 @@ FUSION_PARAMETERS: list[Variable] = [
     real("max_residual", _FU.max_residual, "m", "Largest RMS antenna-fit residual of a usable fix, > 0"),
     real("reinit_time", _FU.reinit_time, "s", "Re-initialise on GNSS after rejecting fixes this long, > 0"),
     real("max_coast", _FU.max_coast, "s", "valid goes false this long after the last accepted fix, > 0"),
+    Variable("coast", "string", _FU.coast, "", f"Through a GNSS gap: one of {', '.join(COAST_CHOICES)} (wave-model pseudo-fixes for a vessel on station or moving steadily, or prediction only)"),
+    real("coast_sigma", _FU.coast_sigma, "m", "Standard deviation of a wave-model pseudo-fix, (0, 10]"),
+    real("coast_window", _FU.coast_window, "s", "Span of GNSS anchors for the low-frequency line of coast = band, 10..3600"),
 ]
 FUSION_INPUTS: list[Variable] = [
     *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),
@@ -147,6 +150,7 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
         q=v["q"], r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
+        coast=v["coast"], coast_sigma=v["coast_sigma"], coast_window=v["coast_window"],
     )
 
 

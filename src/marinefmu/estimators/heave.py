@@ -63,6 +63,13 @@ from .wave_peaks import acceleration_spectrum, find_modes
 
 log = logging.getLogger(__name__)
 
+
+class _Silent:
+    """Stands in for the logger of a ``quiet`` observer."""
+
+    def warning(self, *args: Any, **kwargs: Any) -> None:
+        """Drop the message."""
+
 VERTICAL_CHOICES = ("ned", "tilt", "paper")
 MODEL_CHOICES = ("band", "peaks")
 TRANSFER_CHOICES = ("exact", "paper")
@@ -315,6 +322,9 @@ class HeaveObserver:
     ----------
     params : HeaveObserverParams, optional
         Validated parameters (defaults if omitted).
+    quiet : bool
+        Log nothing (for use inside another estimator that reports for itself, such as
+        :class:`~.wave_coast.WaveCoast`, where an axis without waves is normal).
 
     Examples
     --------
@@ -324,8 +334,9 @@ class HeaveObserver:
     (False, 0)
     """
 
-    def __init__(self, params: HeaveObserverParams | None = None) -> None:
+    def __init__(self, params: HeaveObserverParams | None = None, *, quiet: bool = False) -> None:
         self.params = params or HeaveObserverParams()
+        self.log: Any = _Silent() if quiet else log
         self.reset()
 
     def reset(self) -> None:
@@ -391,11 +402,11 @@ class HeaveObserver:
         roll, pitch = float(roll), float(pitch)
         warning = _bad_sample(f, roll, pitch)
         if warning is not None:
-            log.warning("heave observer: %s; coasting on the model", warning)
+            self.log.warning("heave observer: %s; coasting on the model", warning)
         restarted = None
         if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
             restarted = f"step size changed from {self.dt} s to {dt} s; observer restarted"
-            log.warning("heave observer: %s", restarted)
+            self.log.warning("heave observer: %s", restarted)
             self.reset()
         if self.dt is None:
             self._start(dt)
@@ -452,7 +463,7 @@ class HeaveObserver:
         else:
             omega, variance = modes.omega, None
         if len(modes) == 0 or len(omega) == 0:
-            log.warning("heave observer: no spectral peak in [%g, %g] rad/s; modes unchanged", p.omega_min, p.omega_max)
+            self.log.warning("heave observer: no spectral peak in [%g, %g] rad/s; modes unchanged", p.omega_min, p.omega_max)
             return False
         self.peak_period = 2.0 * math.pi / float(modes.omega[np.argmax(modes.amplitude)])
         new = self._build(omega, variance)
