@@ -180,7 +180,7 @@ def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 120 s window and 120 s of
     anchors before it). Real time with ``coast="band"`` (default): measured max per axis
     2-4 / 7.4-13.6 / 4.5-7.3 cm north / east / down over seeds 1-3 (east: roll from the 8 m
-    antenna baseline), against 1-6 m for the inertial coast (README); bound 15 cm per axis.
+    antenna baseline), against metres for the inertial coast (README); bound 15 cm per axis.
     RTS-smoothed through the gap: measured max 1.4-3.0 / 3.3-9.0 / 3.2-4.6 cm, so the 10 cm
     goal holds on every axis (bound 10 cm). Back within 5 cm (3-D) 5 s after the fixes
     return, and valid throughout (within max_coast)."""
@@ -199,7 +199,7 @@ def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
 
 
 def test_inertial_coast_drifts_as_the_gyro_floor_says():
-    """The same dropout coasted inertially drifts by metres (seed 1: 1.1 / 5.5 m north /
+    """The same dropout coasted inertially drifts by metres (seed 1: 6.2 / 1.9 m north /
     east): the gyro bias wander alone allows no better (:func:`coast_floor`, 0.87 m RMS per
     axis after 30 s); the wave-model coast of the same record stays within 15 cm."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
