@@ -136,9 +136,7 @@ class WaveCoast:
             return None
         t = np.array([a[0] for a in self.anchors], dtype=float) - self.k
         y = np.array([a[1] for a in self.anchors])
-        if t[-1] - t[0] <= 0.0:
-            return None
-        slope, level = np.polyfit(t, y, 1)       # per axis, t = 0 now
+        level = np.polyfit(t, y, 1)[1]           # per axis, at t = 0 (now)
         return level + d
 
     # ---- state ------------------------------------------------------------------------------
