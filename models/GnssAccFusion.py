@@ -34,13 +34,15 @@ class GnssAccFusion(Fmi2Slave):
         self.model = self.io.build(lambda values: Estimator(fusion_params(values)))
 
     def do_step(self, current_time, step_size):
-        return self.io.step(lambda: self._step(current_time + step_size, step_size))
+        return self.io.step(self._step, current_time, step_size)
 
     def _step(self, t, dt):
         i = self.io.inputs
         ant = [i[n] for n in ANT_NAMES]
         self.new_connected = self.new_connected or i["gnss.new"]
-        new = i["gnss.valid"] and (i["gnss.new"] if self.new_connected else ant != self.last_fix)
+        # unconnected gnss.new: a change of the positions is a new fix (a held NaN is no change)
+        new = i["gnss.valid"] and (i["gnss.new"] if self.new_connected
+                                    else not np.array_equal(ant, self.last_fix, equal_nan=True))
         if new:
             self.last_fix = ant
         r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), np.array(ant) if new else None, dt,

@@ -27,7 +27,7 @@ class HeaveObserver(Fmi2Slave):
         self.model = self.io.build(lambda values: Estimator(heave_params(values)))
 
     def do_step(self, current_time, step_size):
-        return self.io.step(lambda: self._step(current_time + step_size, step_size))
+        return self.io.step(self._step, current_time, step_size)
 
     def _step(self, t, dt):
         i = self.io.inputs

@@ -32,8 +32,10 @@ class VesselMotion(Fmi2Slave):
             self.io.set_outputs(self.model.peek(self.io.start_time), self.model.boolean_outputs())
 
     def do_step(self, current_time, step_size):
-        return self.io.step(lambda: self.io.set_outputs(self.model.step(current_time + step_size, step_size),
-                                                        self.model.boolean_outputs()))
+        return self.io.step(self._step, current_time, step_size)
+
+    def _step(self, t, dt):
+        self.io.set_outputs(self.model.step(t, dt), self.model.boolean_outputs())
 
     def _get_fmu_state(self):
         return self.io.get_state(self.model)

@@ -68,8 +68,9 @@ def test_bad_epochs_are_skipped_with_a_reason_and_the_filter_coasts(positions, r
     est = GnssAccFusion(FusionParams(propagation="hold"))
     est.step([0.0, 0.0, -9.80665], ARMS, 0.01)
     r = est.step([0.0, 0.0, -9.80665], positions, 0.01)
-    assert r.fix == "skipped" and reason in r.warning and r.valid
+    assert r.fix == "skipped" and reason in r.warning and not r.valid  # flagged on that step (contract)
     assert np.all(np.isfinite(r.pos))
+    assert est.step([0.0, 0.0, -9.80665], None, 0.01).valid  # then coasting, within max_coast
 
 
 @pytest.mark.parametrize("kwargs,match", [

@@ -1,10 +1,11 @@
-"""VesselMotion.fmu under OSP libcosim (libcosimpy) equals the in-process model."""
+"""VesselMotion.fmu under OSP libcosim (libcosimpy) equals the in-process model. Each test runs
+in its own subprocess (marker ``isolated``): a native crash fails that test, not the run."""
 import numpy as np
 import pytest
 
 from marinefmu.sea.motion_model import REAL_OUTPUTS, VesselMotionModel, VesselMotionParams
 
-pytestmark = [pytest.mark.fmu, pytest.mark.libcosim]
+pytestmark = [pytest.mark.fmu, pytest.mark.libcosim, pytest.mark.isolated]
 libcosim = pytest.importorskip("libcosimpy")
 
 

@@ -19,6 +19,7 @@ error logged during initialisation as a refusal and raises with that message.
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
@@ -113,12 +114,20 @@ class SlaveIO:
         self.slave.log(f"{self.slave.instance_name}: {self.error}", Fmi2Status.error)
         return None
 
-    def step(self, fn: Callable[[], None]) -> bool:
-        """Run one step's work ``fn``; return False (fmi2Discard) after logging if the slave
-        was refused at initialisation or ``fn`` raises."""
+    def step(self, fn: Callable[[float, float], None], current_time: float, step_size: float) -> bool:
+        """Run one step's work ``fn(t, dt)`` with ``t = current_time + step_size``; return False
+        (fmi2Discard) after logging if the slave was refused at initialisation or ``fn`` raises.
+
+        A step size that is not a positive finite number is refused the same way, but only for
+        that call: nothing is changed, so the host can retry with a valid step.
+        """
+        if self.error is None and not (math.isfinite(step_size) and step_size > 0.0 and math.isfinite(current_time)):
+            self.slave.log(f"{self.slave.instance_name}: t = {current_time!r} s: communication step size {step_size!r} s "
+                           "refused: must be a finite number > 0; nothing was changed", Fmi2Status.error)
+            return False
         if self.error is None:
             try:
-                fn()
+                fn(current_time + step_size, step_size)
                 return True
             except Exception as exc:  # noqa: BLE001 - never let pythonfmu see an exception
                 self.error = f"step failed: {type(exc).__name__}: {exc}"

@@ -68,7 +68,7 @@ from filterpy.kalman import KalmanFilter
 from ..errors import ParameterTypeError, check_choice, check_range, check_vector
 from ..frames import GRAVITY_N, G, body_to_euler_rates, rigid_point_operator, rot_nb
 from .centred_window import CentredWindow, window_samples
-from .samples import force_beyond_limit, rate_beyond_limit
+from .samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
 
@@ -78,8 +78,6 @@ ANGLE_CHOICES = ("gyro_hp", "input")
 #: loses 0.16 % at 0.2 Hz and 0.8 % at 0.3 Hz while averaging the gyro noise enough that it does
 #: not shrink the offset (noise in α biases the estimate towards the sensor).
 POLYORDER = 4
-#: Largest |roll| and |pitch| accepted from an attitude input [rad] (beyond: a bad sample).
-MAX_TILT = 1.4
 
 
 @dataclass(frozen=True)
@@ -328,8 +326,8 @@ def _bad_sample(acc: np.ndarray, gyro: np.ndarray, euler: np.ndarray | None) -> 
     if euler is not None:
         if not np.all(np.isfinite(euler)):
             return "non-finite roll, pitch or yaw input"
-        if max(abs(euler[0]), abs(euler[1])) > MAX_TILT:
-            return f"roll or pitch input beyond ±{MAX_TILT} rad"
+        if reason := angles_beyond_limit(euler):
+            return f"{reason} (input)"
     return rate_beyond_limit(gyro) or force_beyond_limit(acc)
 
 

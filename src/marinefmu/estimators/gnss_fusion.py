@@ -39,7 +39,7 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    gate on the 3-D innovation (``gate`` in σ) that rejects jumps and outliers; coasting
    (prediction only) through dropouts, with ``valid`` false after ``max_coast`` s;
    re-initialisation on GNSS after ``reinit_time`` s of consecutive rejections (a real
-   reposition, not a glitch); and an RTS fixed-interval smoother for post-processing
+   reposition, not a glitch) and on the first fix after a gap longer than ``max_coast``; and an RTS fixed-interval smoother for post-processing
    (:func:`fuse`, ``smooth=True``; hand-written because filterpy's ``rts_smoother`` has no
    control input, and here x⁻_{k+1} = Φ x_k + G u_k).
 4. **Coasting through GNSS dropouts** (``coast``, beyond the paper). ``"inertial"`` predicts
@@ -127,7 +127,8 @@ class FusionParams:
         Consecutive rejections for this long [s] re-initialise the filter on GNSS, > 0.
         [``reinit_time``]
     max_coast : float
-        ``valid`` goes false this long [s] after the last accepted fix, > 0. [``max_coast``]
+        ``valid`` goes false this long [s] after the last accepted fix, and the first fix after
+        such a gap re-initialises the filter, > 0. [``max_coast``]
     coast : {"band", "inertial"}
         Through a GNSS gap: wave-model pseudo-fixes (a vessel on station or moving steadily)
         or prediction only (module docstring). [``coast``]
@@ -258,7 +259,8 @@ class FusionResult:
         What happened to a GNSS epoch this step: "", "accepted", "rejected", "skipped"; or
         "wave" for a wave-model pseudo-fix in a GNSS gap (``coast="band"``).
     valid : bool
-        Initialised, sample good, and an accepted fix within ``max_coast``.
+        Initialised, samples good (no bad IMU sample, no skipped or rejected GNSS epoch this
+        step), and an accepted fix within ``max_coast``.
     warning : str or None
         Reason for a rejected sample or epoch.
     """
@@ -398,7 +400,9 @@ class GnssAccFusion:
             warning = warning or why
         if not fix and self._pseudo_fix(dt):
             fix = "wave"
-        valid = good and self.initialised and self.since_fix <= p.max_coast
+        # a refused epoch (bad coordinates, poor fit, gated outlier) is a bad sample like a bad
+        # accelerometer one: the output coasts and is flagged for that step
+        valid = good and fix not in ("skipped", "rejected") and self.initialised and self.since_fix <= p.max_coast
         return self._result(fix, valid, warning, w)
 
     def _epoch(self, gnss: Any, dt: float) -> tuple[str, str | None]:
@@ -413,20 +417,28 @@ class GnssAccFusion:
         # the accelerometer point seen by GNSS; the lever arm is rotated with the propagated
         # attitude (a single fix's attitude noise, ~1 mrad, would add ~1 cm over a 10 m arm)
         # from the antenna centroid, the shortest arm (the fix's COG carries its attitude noise
-        # times the centroid's arm)
-        rot_arm = sol.rot if p.propagation == "hold" or not self.initialised else quat_to_rot(self.q)
-        z = sol.centroid + rot_arm @ (np.asarray(p.acc_lever_arm) - p.arms.mean(axis=0))
+        # times the centroid's arm). A (re)start uses the fix's own attitude: after a long gap
+        # the propagated one is off by centiradians, decimetres over the arm.
+        arm = np.asarray(p.acc_lever_arm) - p.arms.mean(axis=0)
+        # after a gap longer than max_coast the output has been invalid for a while and the
+        # coasted velocity and attitude are not worth keeping (an update would pull the position
+        # but keep a metres-per-second velocity error, and gate out the next fixes)
+        restart = not self.initialised or self.since_fix > p.max_coast
+        rot_arm = sol.rot if p.propagation == "hold" or restart else quat_to_rot(self.q)
+        z = sol.centroid + rot_arm @ arm
         r_meas = np.eye(3) * (p.r / dt)  # eq. 17
-        if not self.initialised:
+        if restart:
+            gap_s, first = self.since_fix, not self.initialised
             self._initialise(sol, z, r_meas)
-            return "accepted", None
+            return "accepted", None if first else (f"GNSS back after {gap_s:.0f} s without a fix (> max_coast): "
+                                                   "filter re-initialised on GNSS")
         y = z - self.kf.H @ self.kf.x.ravel()
         s = self.kf.H @ self.kf.P @ self.kf.H.T + r_meas
         d = math.sqrt(float(y @ np.linalg.solve(s, y)))
         if d > p.gate:
             self.rejecting += gap
             if self.rejecting >= p.reinit_time:
-                self._initialise(sol, z, r_meas)
+                self._initialise(sol, sol.centroid + sol.rot @ arm, r_meas)
                 return "accepted", f"GNSS fixes rejected for {p.reinit_time} s: filter re-initialised on GNSS"
             return "rejected", f"GNSS epoch rejected: innovation {d:.1f} sigma > gate {p.gate}"
         self.kf.update(z, R=r_meas)

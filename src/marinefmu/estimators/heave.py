@@ -53,12 +53,12 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError, check_choice, check_int, check_range, check_vector
+from ..errors import check_choice, check_int, check_range, check_vector
 from ..frames import G
 from .fixed_lag import FixedLagOutputs
 from .band_bank import band_elements, band_grid, build_band_bank
 from .oscillator_bank import DISCRETISATIONS, MEASUREMENTS, BankModel, build_bank, carry_map
-from .samples import force_beyond_limit
+from .samples import angles_beyond_limit, force_beyond_limit
 from .wave_peaks import acceleration_spectrum, find_modes
 
 log = logging.getLogger(__name__)
@@ -73,8 +73,6 @@ class _Silent:
 VERTICAL_CHOICES = ("ned", "tilt", "paper")
 MODEL_CHOICES = ("band", "peaks")
 TRANSFER_CHOICES = ("exact", "paper")
-#: Largest |roll|, |pitch| accepted as a physical sample [rad].
-MAX_TILT = 1.2
 
 
 @dataclass(frozen=True)
@@ -260,9 +258,7 @@ def central_rate(prev: tuple[float, float], nxt: tuple[float, float], dt: float)
 def _bad_sample(acc: np.ndarray, roll: float, pitch: float) -> str | None:
     if not (np.all(np.isfinite(acc)) and math.isfinite(roll) and math.isfinite(pitch)):
         return "non-finite acceleration or angle sample"
-    if max(abs(roll), abs(pitch)) > MAX_TILT:
-        return f"roll or pitch beyond ±{MAX_TILT} rad"
-    return force_beyond_limit(acc)
+    return angles_beyond_limit((roll, pitch)) or force_beyond_limit(acc)
 
 
 # ---- stateful observer ----------------------------------------------------------------------

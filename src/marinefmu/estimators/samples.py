@@ -9,6 +9,11 @@ import numpy as np
 #: Largest angular rate [rad/s] and specific force [m/s²] accepted as a physical sample.
 MAX_RATE = 10.0
 MAX_SPECIFIC_FORCE = 200.0
+#: Largest |roll| and |pitch| [rad] accepted from an attitude input (80°).
+MAX_TILT = math.radians(80.0)
+#: Largest |yaw| [rad] accepted from an attitude input: an unwrapped heading may grow with turns,
+#: but 1e4 rad is some 1,600 turns, beyond any single run.
+MAX_YAW = 1e4
 
 
 def force_beyond_limit(acc: np.ndarray) -> str | None:
@@ -19,3 +24,12 @@ def force_beyond_limit(acc: np.ndarray) -> str | None:
 def rate_beyond_limit(gyro: np.ndarray) -> str | None:
     """Reason if a component of the finite rate ``gyro`` [rad/s] exceeds :data:`MAX_RATE`."""
     return f"gyro sample beyond ±{MAX_RATE} rad/s" if np.max(np.abs(gyro)) > MAX_RATE else None
+
+
+def angles_beyond_limit(euler: np.ndarray) -> str | None:
+    """Reason if finite (roll, pitch[, yaw]) ``euler`` [rad] exceed :data:`MAX_TILT` / :data:`MAX_YAW`."""
+    if max(abs(euler[0]), abs(euler[1])) > MAX_TILT:
+        return f"roll or pitch beyond ±{math.degrees(MAX_TILT):.0f}°"
+    if len(euler) > 2 and abs(euler[2]) > MAX_YAW:
+        return f"yaw beyond ±{MAX_YAW:g} rad"
+    return None

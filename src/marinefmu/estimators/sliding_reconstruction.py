@@ -20,21 +20,19 @@ window was replaced, on the bad step itself, and until the first window is full.
 from __future__ import annotations
 
 import logging
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import check_choice, check_range, check_vector
 from ..frames import G, rot_nb
-from .samples import force_beyond_limit
+from .samples import angles_beyond_limit, force_beyond_limit
 from .reconstruction import (
     TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, lowpass_decimate,
     tilt_correct,
 )
 
 log = logging.getLogger(__name__)
-MAX_TILT = math.radians(80.0)
 
 
 @dataclass(frozen=True)
@@ -267,9 +265,4 @@ def _check_sample(acc: np.ndarray, euler: np.ndarray) -> str | None:
         return "sample of the wrong shape"
     if not (np.all(np.isfinite(acc)) and np.all(np.isfinite(euler))):
         return "non-finite acc or attitude sample"
-    too_big = force_beyond_limit(acc)
-    if too_big:
-        return too_big
-    if abs(euler[0]) > MAX_TILT or abs(euler[1]) > MAX_TILT:
-        return "roll or pitch beyond ±80°"
-    return None
+    return force_beyond_limit(acc) or angles_beyond_limit(euler)
