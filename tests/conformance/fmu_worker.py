@@ -198,12 +198,37 @@ def case_run(name: str, fmu_dir: Path, work: Path) -> dict:
     """Load, run 200 steps, report finiteness and whether marinefmu is importable here."""
     import importlib.util
 
+    importable = importlib.util.find_spec("marinefmu") is not None  # before the FMU adds its resources
     inst, feed = start(name, fmu_dir, work)
     out = np.array(advance(inst, feed, 0, 200))
     inst.close()
-    return {"finite": bool(np.all(np.isfinite(out))), "steps": len(out),
-            "marinefmu_importable": importlib.util.find_spec("marinefmu") is not None,
-            "python": sys.executable}
+    return {"finite": bool(np.all(np.isfinite(out))), "steps": len(out), "marinefmu_importable": importable,
+            "marinefmu_used": sys.modules["marinefmu"].__file__ if "marinefmu" in sys.modules else None,
+            "unzipped_to": str(_UNZIPPED[name]), "python": sys.executable}
+
+
+def case_libcosim_run(name: str, fmu_dir: Path, work: Path) -> dict:
+    """Load the FMU alone in a libcosim execution (inputs at their start values), run 200 steps."""
+    import importlib.util
+
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    importable = importlib.util.find_spec("marinefmu") is not None  # before the FMU adds its resources
+    log_output_level(CosimLogLevel.ERROR)
+    md = read_model_description(str(Path(fmu_dir) / f"{name}.fmu"))
+    reals = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    ex = CosimExecution.from_step_size(step_size=round(DT * 1e9))
+    index = ex.add_local_slave(CosimLocalSlave(fmu_path=str(Path(fmu_dir) / f"{name}.fmu"), instance_name=name))
+    obs = CosimObserver.create_last_value()
+    ex.add_observer(obs)
+    ok = ex.simulate_until(round(200 * DT * 1e9))
+    values = obs.last_real_values(index, reals)
+    return {"simulated": bool(ok), "finite": bool(np.all(np.isfinite(values))), "outputs": len(values),
+            "marinefmu_importable": importable,
+            "marinefmu_used": sys.modules["marinefmu"].__file__ if "marinefmu" in sys.modules else None}
 
 
 def case_two_instances(name: str, fmu_dir: Path, work: Path) -> dict:

@@ -3,7 +3,9 @@
 Each FMU bundles ``src/marinefmu`` in its resources, so it runs without the source tree
 (but note: FMUs in one process share one interpreter, so an already imported ``marinefmu``
 is the one used). After pythonfmu writes the FMU, :mod:`marinefmu.cosim.units` adds units
-and initial unknowns, and ``fmpy.validation.validate_fmu`` must report nothing.
+and initial unknowns, :mod:`marinefmu.cosim.osp` writes ``<Model>_OspModelDescription.xml``
+next to it, and ``fmpy.validation.validate_fmu`` and :func:`marinefmu.cosim.osp.check` must
+report nothing.
 
 A build is skipped when a stamp (hash of the model script, every file of the package and the
 pythonfmu version) matches the previous build, so ``make test`` after ``make demo`` is quick.
@@ -22,6 +24,7 @@ import pythonfmu
 
 from ..errors import MarineFmuError
 from .units import postprocess_model_description
+from . import osp
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -71,7 +74,8 @@ def build_one(script: Path, dest: Path, force: bool = False) -> BuildResult:
     fmu = dest / f"{script.stem}.fmu"
     stamp = dest / ".build-stamps" / f"{script.stem}.sha256"
     fingerprint = _fingerprint(script)
-    if not force and fmu.exists() and stamp.exists() and stamp.read_text() == fingerprint:
+    osp_file = dest / f"{script.stem}_OspModelDescription.xml"
+    if not force and fmu.exists() and osp_file.exists() and stamp.exists() and stamp.read_text() == fingerprint:
         return BuildResult(fmu, False)
     from pythonfmu.builder import FmuBuilder
 
@@ -86,7 +90,10 @@ def build_one(script: Path, dest: Path, force: bool = False) -> BuildResult:
                 if item.filename == "modelDescription.xml":
                     data = postprocess_model_description(data, units)
                 zout.writestr(item, data)
-    problems = validate(fmu)
+    with zipfile.ZipFile(fmu) as z:
+        md_xml = z.read("modelDescription.xml")
+    osp.write(md_xml, osp_file)
+    problems = validate(fmu) + osp.check(md_xml, osp_file.read_bytes())
     if problems:
         fmu.unlink()
         raise BuildError(f"{fmu.name} failed validation:\n  " + "\n  ".join(problems))
