@@ -9,6 +9,9 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 - ``fmpy_dostep_all``: plus reading all outputs each step;
 - ``in_process``: ``VesselMotionModel.step`` without FMI;
 - ``system_runner``: the FMPy system master recording every output.
+
+Then the memory of every FMU over 10⁶ steps and over 1,000 instantiate/free cycles
+(:mod:`marinefmu.bench_memory`, issue 8).
 """
 from __future__ import annotations
 
@@ -117,8 +120,28 @@ def reconstruction_seconds(hours: float = 1.0) -> dict[str, float]:
     return {"batch_1h_100hz_3axis_s": batch, "sliding_per_step_us": per_step}
 
 
-def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None) -> dict:
-    """Run every measurement, write ``out_dir/bench.json`` and print a table; return the data."""
+def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
+    """Memory growth of every FMU over ``steps`` steps and ``cycles`` instantiate/free cycles,
+    each in a fresh process (:mod:`marinefmu.bench_memory`); printed as it goes (it is long)."""
+    from .bench_memory import run_isolated
+
+    result = {}
+    for fmu in sorted(fmu_dir.glob("*.fmu")):
+        start = time.perf_counter()
+        result[fmu.stem] = {"steps": run_isolated("steps", fmu, steps) if steps else None,
+                            "cycles": run_isolated("cycles", fmu, cycles) if cycles else None}
+        growth = {k: (v or {}).get("growth_mb") for k, v in result[fmu.stem].items()}
+        print(f"memory {fmu.stem:26s} growth over {steps} steps: {growth['steps']} MB, over {cycles} cycles: "
+              f"{growth['cycles']} MB ({time.perf_counter() - start:.0f} s)", flush=True)
+    return result
+
+
+def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None,
+                   memory_steps: int = 1_000_000, memory_cycles: int = 1000) -> dict:
+    """Run every measurement, write ``out_dir/bench.json`` and print a table; return the data.
+
+    The memory part (``memory_steps`` steps and ``memory_cycles`` cycles per FMU; 0 skips) is
+    the long one: about an hour at the defaults on a 2-core machine."""
     from .cosim.build import build_all, repo_root
 
     if fmu_dir is None:
@@ -145,12 +168,15 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
         "goal": {"fmpy_steps_per_second": 20000, "met_by_fmpy_dostep": rates["fmpy_dostep"] >= 20000},
     }
     out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "bench.json").write_text(json.dumps(data, indent=2))
+    (out_dir / "bench.json").write_text(json.dumps(data, indent=2))  # the speed figures, before the long part
     print(f"VesselMotion, 200 components, dt = {DT} s, best of 3 × {steps} steps ({data['date']}, {data['machine']['cpu']}, {data['machine']['cores']} cores)")
     print(f"{'measurement':24s} {'steps/s':>10s} {'3 h @ 100 Hz':>14s}")
     for k, v in rates.items():
         print(f"{k:24s} {v:10,.0f} {three_hours / v:12.1f} s")
     print(f"reconstruct_displacement, 1 h of 100 Hz 3-axis acceleration: {recon['batch_1h_100hz_3axis_s']:.1f} s (goal <= 10 s)")
     print(f"DisplacementReconstructor per step (200 s window, 10 s hop, refits included): {recon['sliding_per_step_us']:.0f} µs")
+    data["memory"] = memory(fmu_dir, memory_steps, memory_cycles)
+    data["setup"]["memory"] = {"steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0}
+    (out_dir / "bench.json").write_text(json.dumps(data, indent=2))
     print(f"wrote {out_dir / 'bench.json'}")
     return data

@@ -72,7 +72,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from .bench import run_benchmarks
 
-    run_benchmarks(Path(args.out), steps=args.steps)
+    run_benchmarks(Path(args.out), steps=args.steps, memory_steps=args.memory_steps, memory_cycles=args.memory_cycles)
     return 0
 
 
@@ -118,6 +118,10 @@ def main(argv: list[str] | None = None) -> int:
     k = sub.add_parser("bench", help="measure speed (writes JSON and prints a table)")
     k.add_argument("--out", default="bench", help="output folder for bench.json (default bench/)")
     k.add_argument("--steps", type=int, default=60000, help="FMU steps per measurement (default 60000)")
+    k.add_argument("--memory-steps", type=int, default=1_000_000,
+                   help="steps per FMU of the memory measurement (default 1000000; 0 skips it)")
+    k.add_argument("--memory-cycles", type=int, default=1000,
+                   help="instantiate/free cycles per FMU of the memory measurement (default 1000; 0 skips it)")
     k.set_defaults(func=_cmd_bench)
     e = sub.add_parser("example", help="run one of the papers' examples (list them with --list)")
     e.add_argument("name", nargs="?", help="example name, e.g. paper001-fig7")

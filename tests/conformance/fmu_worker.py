@@ -427,6 +427,22 @@ def case_step_sizes(name: str, fmu_dir: Path, work: Path) -> dict:
     return result
 
 
+def case_quaternion_norm(name: str, fmu_dir: Path, work: Path) -> dict:
+    """10⁶ steps of gyro-only integration (mode 0) of a constant tumble (0.3, -0.2, 0.5 rad/s,
+    ~16 000 turns in 10⁴ s): the largest deviation of |q| from 1, read every 10⁵ steps."""
+    inst = Instance(fmu_dir, name, work)
+    inst.init({"mode": 0, "init": "given"})
+    inst.set_inputs({"gyro.x": 0.3, "gyro.y": -0.2, "gyro.z": 0.5, "acc.x": 0.0, "acc.y": 0.0, "acc.z": -9.80665})
+    q_refs = [inst.var[f"q.{c}"].valueReference for c in "wxyz"]
+    worst, statuses, steps = 0.0, set(), 1_000_000
+    for k in range(steps):
+        statuses.add(inst.step(k * 0.01, 0.01))
+        if (k + 1) % 100_000 == 0:
+            worst = max(worst, abs(math.sqrt(sum(c * c for c in inst.fmu.getReal(q_refs))) - 1.0))
+    inst.close()
+    return {"steps": steps, "statuses": sorted(statuses), "max_norm_error": worst}
+
+
 def case_logging_off(name: str, fmu_dir: Path, work: Path) -> dict:
     """With logging off: a refused parameter and a zero step still return a non-OK status."""
     key, value = BAD_PARAMETER[name]

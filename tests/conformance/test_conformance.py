@@ -24,6 +24,7 @@ TIMEOUT = 300.0  # s per case; the slowest takes ~15 s on the 2-core CI machine
 ESTIMATORS = [n for n in FMUS if n != "VesselMotion"]
 #: (case, FMUs it applies to), in the order they are started.
 PLAN = [
+    ("quaternion_norm", ["AttitudeEstimator"]),  # the longest case (~30 s) first
     ("faults", ESTIMATORS),
     ("state", FMUS),
     ("two_instances", FMUS),
@@ -180,6 +181,12 @@ def test_an_hour_of_zero_input(conformance, name):
     every output finite."""
     r = result_of(conformance, "zero_hour", name)
     assert r["statuses"] == [0] and r["finite"] and r["seconds"] == 3600.0, r
+
+
+def test_quaternion_norm_after_a_million_steps(conformance):
+    r = result_of(conformance, "quaternion_norm", "AttitudeEstimator")
+    assert r["steps"] == 1_000_000 and r["statuses"] == [0], r
+    assert r["max_norm_error"] < 1e-9, r
 
 
 def test_five_minute_gnss_dropout(conformance):
