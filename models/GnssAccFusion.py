@@ -14,48 +14,51 @@ from marinefmu.estimators.gnss_fusion import GnssAccFusion as Estimator
 ANT_NAMES = [f"gnss.ant{i}.{a}" for i in range(1, 5) for a in "ned"]
 
 
-class GnssAccFusion(Fmi2Slave):
-    author = "marinefmu developers"
-    description = "Multi-antenna GNSS + accelerometer Kalman fusion with attitude correction (paper 001)"
-    version = __version__
-    license = "MIT"
+if "GnssAccFusion" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun
+    GnssAccFusion = SlaveIO.rerun(globals(), "GnssAccFusion")
+else:
+    class GnssAccFusion(Fmi2Slave):
+        author = "marinefmu developers"
+        description = "Multi-antenna GNSS + accelerometer Kalman fusion with attitude correction (paper 001)"
+        version = __version__
+        license = "MIT"
 
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.io = SlaveIO(self, FUSION_PARAMETERS, FUSION_OUTPUTS, FUSION_BOOLEANS, FUSION_INPUTS)
-        self.model = None
-        self.last_fix = None
-        self.new_connected = False  # gnss.new has been seen true: rely on it, not on changes
+        def __init__(self, **kwargs):
+            super().__init__(**kwargs)
+            self.io = SlaveIO(self, FUSION_PARAMETERS, FUSION_OUTPUTS, FUSION_BOOLEANS, FUSION_INPUTS)
+            self.model = None
+            self.last_fix = None
+            self.new_connected = False  # gnss.new has been seen true: rely on it, not on changes
 
-    def setup_experiment(self, start_time, stop_time, tolerance):
-        self.io.start_time = start_time
+        def setup_experiment(self, start_time, stop_time, tolerance):
+            self.io.start_time = start_time
 
-    def exit_initialization_mode(self):
-        self.model = self.io.build(lambda values: Estimator(fusion_params(values)))
+        def exit_initialization_mode(self):
+            self.model = self.io.build(lambda values: Estimator(fusion_params(values)))
 
-    def do_step(self, current_time, step_size):
-        return self.io.step(self._step, current_time, step_size)
+        def do_step(self, current_time, step_size):
+            return self.io.step(self._step, current_time, step_size)
 
-    def _step(self, t, dt):
-        i = self.io.inputs
-        ant = [i[n] for n in ANT_NAMES]
-        self.new_connected = self.new_connected or i["gnss.new"]
-        # unconnected gnss.new: a change of the positions is a new fix (a held NaN is no change)
-        new = i["gnss.valid"] and (i["gnss.new"] if self.new_connected
-                                    else not np.array_equal(ant, self.last_fix, equal_nan=True))
-        if new:
-            self.last_fix = ant
-        r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), np.array(ant) if new else None, dt,
-                            (i["gyro.x"], i["gyro.y"], i["gyro.z"]))
-        self.io.warn(r.warning, t)
-        self.io.set_outputs([*r.pos, *r.vel, *r.pos_std, *r.euler, *r.acc_n, *r.acc_bias, r.residual],
-                            [r.valid, r.fix == "accepted"])
+        def _step(self, t, dt):
+            i = self.io.inputs
+            ant = [i[n] for n in ANT_NAMES]
+            self.new_connected = self.new_connected or i["gnss.new"]
+            # unconnected gnss.new: a change of the positions is a new fix (a held NaN is no change)
+            new = i["gnss.valid"] and (i["gnss.new"] if self.new_connected
+                                        else not np.array_equal(ant, self.last_fix, equal_nan=True))
+            if new:
+                self.last_fix = ant
+            r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), np.array(ant) if new else None, dt,
+                                (i["gyro.x"], i["gyro.y"], i["gyro.z"]))
+            self.io.warn(r.warning, t)
+            self.io.set_outputs([*r.pos, *r.vel, *r.pos_std, *r.euler, *r.acc_n, *r.acc_bias, r.residual],
+                                [r.valid, r.fix == "accepted"])
 
-    def _get_fmu_state(self):
-        state = self.io.get_state(self.model)
-        state["last_fix"], state["new_connected"] = self.last_fix, self.new_connected
-        return state
+        def _get_fmu_state(self):
+            state = self.io.get_state(self.model)
+            state["last_fix"], state["new_connected"] = self.last_fix, self.new_connected
+            return state
 
-    def _set_fmu_state(self, state):
-        self.last_fix, self.new_connected = state.get("last_fix"), state.get("new_connected", False)
-        self.io.set_state(self.model, state)
+        def _set_fmu_state(self, state):
+            self.last_fix, self.new_connected = state.get("last_fix"), state.get("new_connected", False)
+            self.io.set_state(self.model, state)

@@ -48,4 +48,7 @@ def test_unexpected_step_error_is_contained():
     s.exit_initialization_mode()
     s.model.step = None  # simulate a bug
     assert s.do_step(0.0, 0.01) is False
-    assert "step failed: TypeError" in s.log_queue[-1].msg
+    first = s.log_queue[-1].msg
+    assert "step failed at t = 0.0 s: TypeError" in first and "Traceback (most recent call last)" in first
+    assert s.do_step(0.01, 0.01) is False  # and every later step, without the traceback again
+    assert s.log_queue[-1].msg.endswith("the FMU cannot step") and "Traceback" not in s.log_queue[-1].msg

@@ -443,6 +443,26 @@ def case_quaternion_norm(name: str, fmu_dir: Path, work: Path) -> dict:
     return {"steps": steps, "statuses": sorted(statuses), "max_norm_error": worst}
 
 
+def case_many_instances(name: str, fmu_dir: Path, work: Path) -> dict:
+    """30 instantiate / initialise / 5 steps / free cycles in one process: every step OK, one
+    slave class alive (pythonfmu runs the model script again per instance), no repeated
+    ``sys.path`` entries."""
+    import gc
+
+    statuses = set()
+    for c in range(30):
+        inst, feed = start(name, fmu_dir, work, f"m{c}")
+        for k in range(5):
+            if feed is not None:
+                inst.set_inputs(*feed.at(k))
+            statuses.add(inst.step(k * DT, DT))
+        inst.close()
+    gc.collect()
+    classes = [o for o in gc.get_objects() if isinstance(o, type) and o.__name__ == name and o.__module__ == name]
+    return {"statuses": sorted(statuses), "slave_classes": len(classes),
+            "repeated_sys_path": len(sys.path) - len(set(sys.path))}
+
+
 def case_logging_off(name: str, fmu_dir: Path, work: Path) -> dict:
     """With logging off: a refused parameter and a zero step still return a non-OK status."""
     key, value = BAD_PARAMETER[name]

@@ -15,11 +15,21 @@ the parameter and its range) at initialisation, the model is not built, and ever
 ``doStep`` logs the refusal again and returns ``False`` (fmi2Discard); an unexpected error in
 a step is handled the same way. :class:`~marinefmu.cosim.system.SystemRunner` treats an
 error logged during initialisation as a refusal and raises with that message.
+
+**Memory per instantiation.** pythonfmu 0.7.0's loader executes the model script again for
+every instance (``findClass``) and never releases the list it makes of each class's MRO, so
+the class made by that execution, with its methods, stays alive (about 5 KB), and it inserts
+the resources folder into ``sys.path`` once more. The model scripts therefore bind the class
+made by their import when they run again (:meth:`SlaveIO.rerun`) instead of making a new
+one, and :class:`SlaveIO` drops repeated ``sys.path`` entries. What remains (the MRO lists
+and class-name strings) is measured by ``marinefmu bench`` (README, "FMU contract").
 """
 from __future__ import annotations
 
 import copy
 import math
+import sys
+import traceback
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
@@ -37,6 +47,17 @@ _CAST: dict[str, Callable[[Any], Any]] = {"real": float, "integer": int, "boolea
 
 def _describe(var: Variable) -> str:
     return f"{var.description} [{var.unit}]" if var.unit else var.description
+
+
+#: One reference to a model script's namespace per run of the script by pythonfmu (SlaveIO.rerun).
+_NAMESPACE_REFS: list[dict] = []
+
+
+def _drop_repeated_sys_path() -> None:
+    """Remove repeated ``sys.path`` entries, keeping the first of each (pythonfmu 0.7.0 inserts
+    the FMU's resources folder once more at every instantiation)."""
+    seen: set[str] = set()
+    sys.path[:] = [p for p in sys.path if not (p in seen or seen.add(p))]
 
 
 class SlaveIO:
@@ -58,6 +79,7 @@ class SlaveIO:
 
     def __init__(self, slave: Fmi2Slave, parameters: Sequence[Variable], outputs: Sequence[Variable],
                  boolean_outputs: Sequence[Variable] = (), inputs: Sequence[Variable] = ()) -> None:
+        _drop_repeated_sys_path()
         self.slave = slave
         self.params: dict[str, Any] = {v.name: v.default for v in parameters}
         self.inputs: dict[str, Any] = {v.name: v.default for v in inputs}
@@ -94,6 +116,23 @@ class SlaveIO:
         )
 
     @staticmethod
+    def rerun(namespace: dict[str, Any], name: str) -> type:
+        """The slave class ``name`` made when the model script was imported, for the script's
+        later runs by pythonfmu's loader (one per instance), which would otherwise make a new
+        class each time.
+
+        pythonfmu 0.7.0's ``findClass`` runs the script again in the module's namespace, keeps
+        every class that run makes alive (the MRO list it takes of each is never released:
+        about 5 KB per instance with the methods), and releases a reference to the module's
+        namespace it never took (``Py_DECREF`` of the borrowed ``PyModule_GetDict``). The new
+        methods' references to the namespace used to hide that; with no new methods the
+        namespace would be freed after a few instances, so one reference is kept here for each
+        run (8 bytes).
+        """
+        _NAMESPACE_REFS.append(namespace)
+        return namespace[name]
+
+    @staticmethod
     def _item_getter(values: list, i: int) -> Callable[[], Any]:
         return lambda: values[i]
 
@@ -118,6 +157,7 @@ class SlaveIO:
         """Run one step's work ``fn(t, dt)`` with ``t = current_time + step_size``; return False
         (fmi2Discard) after logging if the slave was refused at initialisation or ``fn`` raises.
 
+        An exception in ``fn`` is logged with its traceback once; every later step is refused.
         A step size that is not a positive finite number is refused the same way, but only for
         that call: nothing is changed, so the host can retry with a valid step.
         """
@@ -130,7 +170,9 @@ class SlaveIO:
                 fn(current_time + step_size, step_size)
                 return True
             except Exception as exc:  # noqa: BLE001 - never let pythonfmu see an exception
-                self.error = f"step failed: {type(exc).__name__}: {exc}"
+                self.error = f"step failed at t = {current_time!r} s: {type(exc).__name__}: {exc}"
+                self.slave.log(f"{self.slave.instance_name}: {self.error}\n{traceback.format_exc()}", Fmi2Status.error)
+                return False
         self.slave.log(f"{self.slave.instance_name}: {self.error}; the FMU cannot step", Fmi2Status.error)
         return False
 

@@ -71,6 +71,19 @@ def _cr_angles(out: Path) -> dict:
     return {f"{label} ({rms:.2f} deg RMS): CR shift x/y/z [m]": np.array(shift) for label, rms, *shift in r["rows"]}
 
 
+def _heave(out: Path) -> dict:
+    from . import paper003
+
+    r = paper003.compare()
+    out.mkdir(parents=True, exist_ok=True)
+    paper003.plot(r, out / "paper003_heave.png")
+    figures = {f"{label} RMS error IMU/point [cm]": 100 * np.array([run["rms_imu"], run["rms_point"]])
+               for label, run in r["runs"].items()}
+    figures["band delayed heave RMS error [cm]"] = 100 * r["runs"]["band"]["rms_delayed"]
+    figures["heave std IMU/point [cm]"] = 100 * np.array([r["std_imu"], r["std_point"]])
+    return figures
+
+
 #: name → (description, runner(out folder) → printable figures)
 EXAMPLES: dict[str, tuple[str, Callable[[Path], dict]]] = {
     "paper000-sdof": ("Paper 000 §4: SDOF Cummins model, decomposition and drift-free reconstruction", _sdof),
@@ -85,6 +98,8 @@ EXAMPLES: dict[str, tuple[str, Callable[[Path], dict]]] = {
     "paper002-convergence": ("Paper 002: CR of two sensors against known truth (10 min, MEMS noise)", _cr_convergence),
     "paper002-weak-translation": ("Paper 002: CR with weak translations (small floor), against truth", _cr_weak),
     "paper002-angle-errors": ("Paper 002's z discrepancy: CR shift from roll/pitch errors and the high-pass angles (plot)", _cr_angles),
+    "paper003-heave": ("Paper 003: real-time and delayed heave at the IMU and a bow point vs truth, the paper's modes "
+                       "and high-pass integration, Hs 2.5 m Tp 9 s, 12 min (plot)", _heave),
 }
 
 
