@@ -8,6 +8,7 @@ import pytest
 from filterpy.kalman import KalmanFilter, rts_smoother
 
 from marinefmu.errors import ParameterError
+from marinefmu.examples import paper003
 from marinefmu.estimators.fixed_lag import FixedLagOutputs
 from marinefmu.estimators.heave import (
     HeaveObserver, HeaveObserverParams, point_heave, vertical_acceleration,
@@ -15,11 +16,10 @@ from marinefmu.estimators.heave import (
 from marinefmu.estimators.band_bank import build_band_bank, discretise, resonator
 from marinefmu.estimators.oscillator_bank import build_bank, carry_map, mode_noise_covariance, mode_transition
 from marinefmu.frames import G, body_to_euler_rates
-from marinefmu.sea.motion_model import VesselMotionParams, simulate_record, stack
+from marinefmu.sea.motion_model import stack
 from marinefmu.sea.waves import SeaState, realise
 
-DT = 0.05
-IMU, ARM = (-5.0, 1.0, -3.0), (40.0, 0.0, -5.0)
+DT, IMU, ARM = paper003.DT, paper003.IMU, paper003.ARM
 
 
 def _run(params, acc, roll, pitch, dt=DT):
@@ -101,9 +101,7 @@ def test_carry_map_keeps_heave_heave_rate_and_offset():
 
 
 def _record(hs, tp):
-    flat = {"sea.hs": hs, "sea.tp": tp, "sea.seed": 3, "sea.heading": 0.75 * math.pi,
-            **{f"imu.{a}": v for a, v in zip("xyz", IMU)}, **{f"point.{a}": i + r for a, i, r in zip("xyz", IMU, ARM)}}
-    return simulate_record(VesselMotionParams.from_flat(flat), 1920.0, DT)
+    return paper003.record(hs, tp)  # 30 min after 2 min, 20 Hz, IMU and bow point as IMU / ARM
 
 
 def test_van_loan_discretisation_equals_the_closed_form_oscillator():

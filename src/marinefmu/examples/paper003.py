@@ -8,7 +8,7 @@ positive down, against the truth at the IMU and at the bow point.
 * :func:`compare`: the default band model (real time and delayed), the paper's undamped modes
   (``model = peaks``), and the high-pass double integration of most motion reference units
   (4th-order Butterworth, causal) at the cutoff best for the record among
-  :data:`HP_CUTOFFS`, fed the vertical acceleration at the IMU (the same sensor) and, at the
+  :data:`HP_CUTOFFS` (chosen at each place), fed the vertical acceleration at the IMU (the same sensor) and, at the
   bow point, the point's exact acceleration (a noise-free sensor there: its best case).
 * :func:`plot`: a minute of bow heave (truth and the three real-time estimates) and the error
   of each over the whole run.
@@ -69,11 +69,14 @@ def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
     f, roll, pitch = stack(rec, "imu.acc"), rec["truth.roll"], rec["truth.pitch"]
     a_imu = np.array([vertical_acceleration(f[k], roll[k], pitch[k], "ned") for k in range(len(f))])
     a_pt = rec["truth.point_acc.d"]  # at the point the baseline gets the exact acceleration: its best case
-    best = min(HP_CUTOFFS, key=lambda c: _rms(highpass_double_integration(a_imu, DT, c)[k0:] - truth["imu"][k0:]))
-    hp_imu, hp_pt = highpass_double_integration(a_imu, DT, best), highpass_double_integration(a_pt, DT, best)
-    runs["high-pass"] = {"imu": hp_imu, "point": hp_pt, "cutoff": best,
-                         "rms_imu": _rms(hp_imu[k0:] - truth["imu"][k0:]), "rms_point": _rms(hp_pt[k0:] - truth["point"][k0:])}
-    return {"sea": (hs, tp), "t": (np.arange(len(hp_imu)) + 1) * DT, "truth": truth, "runs": runs,
+    hp = {}
+    for where, acc in (("imu", a_imu), ("point", a_pt)):
+        cutoff = min(HP_CUTOFFS, key=lambda c: _rms(highpass_double_integration(acc, DT, c)[k0:] - truth[where][k0:]))
+        hp[where] = highpass_double_integration(acc, DT, cutoff)
+        hp[f"rms_{where}"] = _rms(hp[where][k0:] - truth[where][k0:])
+        hp[f"cutoff_{where}"] = cutoff
+    runs["high-pass"] = hp
+    return {"sea": (hs, tp), "t": (np.arange(len(a_imu)) + 1) * DT, "truth": truth, "runs": runs,
             "std_imu": float(np.std(truth["imu"][k0:])), "std_point": float(np.std(truth["point"][k0:]))}
 
 
