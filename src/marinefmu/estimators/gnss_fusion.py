@@ -39,9 +39,10 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    gate on the 3-D innovation (``gate`` in σ) that rejects jumps and outliers; coasting
    (prediction only) through dropouts, with ``valid`` false after ``max_coast`` s;
    re-initialisation on GNSS after ``reinit_time`` s of consecutive rejections (a real
-   reposition, not a glitch) and on the first fix after a gap longer than ``max_coast``; and an RTS fixed-interval smoother for post-processing
-   (:func:`fuse`, ``smooth=True``; hand-written because filterpy's ``rts_smoother`` has no
-   control input, and here x⁻_{k+1} = Φ x_k + G u_k).
+   reposition, not a glitch) and on the first fix after a gap longer than ``max_coast``; and
+   an RTS fixed-interval smoother for post-processing (:func:`fuse`, ``smooth=True``;
+   hand-written because filterpy's ``rts_smoother`` has no control input, and here
+   x⁻_{k+1} = Φ x_k + G u_k).
 4. **Coasting through GNSS dropouts** (``coast``, beyond the paper). ``"inertial"`` predicts
    only; with a MEMS gyro this drifts by metres in 30 s whatever the filter (the gyro bias
    wander alone: :func:`~.wave_coast.coast_floor`, 0.87 m RMS per axis after 30 s for
