@@ -10,7 +10,8 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 - ``in_process``: ``VesselMotionModel.step`` without FMI;
 - ``system_runner``: the FMPy system master recording every output.
 
-Then the memory of every FMU over 10⁶ steps and over 1,000 instantiate/free cycles
+Then (``parts``): the paper 003 heave accuracy over five seas (:func:`heave_accuracy`), and
+the memory of every FMU over 10⁶ steps and over 1,000 instantiate/free cycles
 (:mod:`marinefmu.bench_memory`, issue 8).
 """
 from __future__ import annotations
@@ -136,17 +137,14 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
     return result
 
 
-def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None,
-                   memory_steps: int = 1_000_000, memory_cycles: int = 1000) -> dict:
-    """Run every measurement, write ``out_dir/bench.json`` and print a table; return the data.
+#: Parts of ``marinefmu bench``, in the order they run.
+PARTS = ("speed", "heave", "memory")
+#: Seas of the heave accuracy part (paper 003 checks: Hs [m], Tp [s]).
+HEAVE_SEAS = ((1.0, 6.0), (4.0, 6.0), (2.5, 9.0), (1.0, 14.0), (4.0, 14.0))
 
-    The memory part (``memory_steps`` steps and ``memory_cycles`` cycles per FMU; 0 skips) is
-    the long one: about an hour at the defaults on a 2-core machine."""
-    from .cosim.build import build_all, repo_root
 
-    if fmu_dir is None:
-        build_all(verbose=False)
-        fmu_dir = repo_root() / "fmus"
+def speed(fmu_dir: Path, steps: int) -> dict:
+    """VesselMotion steps per second (module docstring) and the reconstruction timings."""
     fmu = fmu_dir / "VesselMotion.fmu"
     all_outputs = [v.name for v in REAL_OUTPUTS]
     rates = {
@@ -158,25 +156,76 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     }
     three_hours = 3 * 3600 / DT
     recon = reconstruction_seconds()
-    data = {
-        "reconstruction": recon,
-        "date": datetime.date.today().isoformat(),
-        "machine": machine(),
-        "setup": {"model": "VesselMotion", "wave_components": 200, "step_s": DT, "steps": steps, "repeats": 3},
-        "steps_per_second": rates,
-        "three_hour_100hz_record_s": {k: three_hours / v for k, v in rates.items()},
-        "goal": {"fmpy_steps_per_second": 20000, "met_by_fmpy_dostep": rates["fmpy_dostep"] >= 20000},
-    }
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "bench.json").write_text(json.dumps(data, indent=2))  # the speed figures, before the long part
-    print(f"VesselMotion, 200 components, dt = {DT} s, best of 3 × {steps} steps ({data['date']}, {data['machine']['cpu']}, {data['machine']['cores']} cores)")
+    print(f"VesselMotion, 200 components, dt = {DT} s, best of 3 × {steps} steps")
     print(f"{'measurement':24s} {'steps/s':>10s} {'3 h @ 100 Hz':>14s}")
     for k, v in rates.items():
         print(f"{k:24s} {v:10,.0f} {three_hours / v:12.1f} s")
     print(f"reconstruct_displacement, 1 h of 100 Hz 3-axis acceleration: {recon['batch_1h_100hz_3axis_s']:.1f} s (goal <= 10 s)")
     print(f"DisplacementReconstructor per step (200 s window, 10 s hop, refits included): {recon['sliding_per_step_us']:.0f} µs")
-    data["memory"] = memory(fmu_dir, memory_steps, memory_cycles)
-    data["setup"]["memory"] = {"steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0}
-    (out_dir / "bench.json").write_text(json.dumps(data, indent=2))
-    print(f"wrote {out_dir / 'bench.json'}")
+    return {
+        "reconstruction": recon,
+        "setup": {"model": "VesselMotion", "wave_components": 200, "step_s": DT, "steps": steps, "repeats": 3},
+        "steps_per_second": rates,
+        "three_hour_100hz_record_s": {k: three_hours / v for k, v in rates.items()},
+        "goal": {"fmpy_steps_per_second": 20000, "met_by_fmpy_dostep": rates["fmpy_dostep"] >= 20000},
+    }
+
+
+def heave_accuracy() -> dict[str, dict]:
+    """Paper 003 accuracy over :data:`HEAVE_SEAS`: 30 min after 2 min each
+    (:func:`marinefmu.examples.paper003.compare`), RMS errors [cm] and the issue's goals."""
+    from .examples import paper003
+
+    result = {}
+    for hs, tp in HEAVE_SEAS:
+        r = paper003.compare(hs, tp, duration=1920.0)
+        runs = {label: {k: 100 * v for k, v in run.items() if k.startswith("rms_")} for label, run in r["runs"].items()}
+        goal = {"real_time_imu": max(2.0, 2.5 * r["std_imu"]), "real_time_point": max(2.0, 2.5 * r["std_point"]),
+                "delayed": max(1.0, 1.0 * r["std_imu"])}  # [cm]: max(2 cm, 2.5 %), max(1 cm, 1 %) of the std in m
+        band = runs["band"]
+        met = (band["rms_imu"] <= goal["real_time_imu"] and band["rms_point"] <= goal["real_time_point"]
+               and band["rms_delayed"] <= goal["delayed"])
+        result[f"Hs {hs:g} Tp {tp:g}"] = {"std_cm": [100 * r["std_imu"], 100 * r["std_point"]], "rms_cm": runs,
+                                          "goal_cm": goal, "met": met}
+        print(f"heave Hs {hs:g} m Tp {tp:g} s: band {band['rms_imu']:.2f} / {band['rms_point']:.2f} cm, delayed "
+              f"{band['rms_delayed']:.2f} cm (goal {goal['real_time_imu']:.2f} / {goal['real_time_point']:.2f} / "
+              f"{goal['delayed']:.2f} cm: {'met' if met else 'NOT met'}); paper's modes {runs['peaks (paper)']['rms_imu']:.2f} cm; "
+              f"high-pass {runs['high-pass']['rms_imu']:.2f} cm", flush=True)
+    return result
+
+
+def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None,
+                   memory_steps: int = 1_000_000, memory_cycles: int = 1000,
+                   parts: tuple[str, ...] = PARTS) -> dict:
+    """Run the chosen ``parts`` (:data:`PARTS`), merge them into ``out_dir/bench.json`` (each
+    part keeps its own date and machine, so parts can be re-measured one at a time) and print
+    what they measure; return the whole file's data.
+
+    ``speed`` takes a few minutes, ``heave`` about five, ``memory`` (``memory_steps`` steps
+    and ``memory_cycles`` cycles per FMU) about an hour on a 2-core machine."""
+    from .cosim.build import build_all, repo_root
+
+    unknown = set(parts) - set(PARTS)
+    if unknown:
+        raise ValueError(f"bench parts must be among {', '.join(PARTS)}; got {', '.join(sorted(unknown))}")
+    if fmu_dir is None:
+        build_all(verbose=False)
+        fmu_dir = repo_root() / "fmus"
+    path = out_dir / "bench.json"
+    data = json.loads(path.read_text()) if path.exists() else {}
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stamp = {"date": datetime.date.today().isoformat(), "machine": machine()}
+    print(f"marinefmu bench {', '.join(parts)} ({stamp['date']}, {stamp['machine']['cpu']}, {stamp['machine']['cores']} cores)")
+    for part in PARTS:
+        if part not in parts:
+            continue
+        if part == "speed":
+            data.update(speed(fmu_dir, steps), **stamp)  # the speed figures stay at the top level
+        elif part == "heave":
+            data["heave"] = {**stamp, "seas": heave_accuracy()}
+        else:
+            data["memory"] = {**stamp, "steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0,
+                              "fmus": memory(fmu_dir, memory_steps, memory_cycles)}
+        path.write_text(json.dumps(data, indent=2))
+    print(f"wrote {path}")
     return data

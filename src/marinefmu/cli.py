@@ -69,10 +69,20 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _bench_parts(text: str) -> str:
+    from .bench import PARTS
+
+    bad = [p for p in text.split(",") if p not in PARTS]
+    if bad:
+        raise argparse.ArgumentTypeError(f"unknown part(s) {', '.join(bad)}: choose from {', '.join(PARTS)}")
+    return text
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     from .bench import run_benchmarks
 
-    run_benchmarks(Path(args.out), steps=args.steps, memory_steps=args.memory_steps, memory_cycles=args.memory_cycles)
+    run_benchmarks(Path(args.out), steps=args.steps, memory_steps=args.memory_steps, memory_cycles=args.memory_cycles,
+                   parts=tuple(args.parts.split(",")))
     return 0
 
 
@@ -118,6 +128,10 @@ def main(argv: list[str] | None = None) -> int:
     k = sub.add_parser("bench", help="measure speed (writes JSON and prints a table)")
     k.add_argument("--out", default="bench", help="output folder for bench.json (default bench/)")
     k.add_argument("--steps", type=int, default=60000, help="FMU steps per measurement (default 60000)")
+    from .bench import PARTS
+
+    k.add_argument("--parts", default=",".join(PARTS), type=_bench_parts,
+                   help=f"comma-separated parts to (re)measure, merged into bench.json (default {','.join(PARTS)})")
     k.add_argument("--memory-steps", type=int, default=1_000_000,
                    help="steps per FMU of the memory measurement (default 1000000; 0 skips it)")
     k.add_argument("--memory-cycles", type=int, default=1000,
