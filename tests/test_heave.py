@@ -181,8 +181,9 @@ def test_heave_accuracy_meets_the_goal(hs, tp, record):
 def test_bias_step_is_absorbed_by_the_offset(record):
     """Paper section 3.2: +2 m/s² on the accelerometer from t = Δt. (A step in mid-run takes
     longer than 60 s to absorb: README, paper 003.)"""
-    acc = stack(record, "imu.acc")
-    roll, pitch = record["truth.roll"], record["truth.pitch"]
+    n = int(600 / DT)  # the first 10 minutes of the record are enough for 120 s + 60 s
+    acc = stack(record, "imu.acc")[:n]
+    roll, pitch = record["truth.roll"][:n], record["truth.pitch"][:n]
     ref, ref_obs = _run(HeaveObserverParams(), acc, roll, pitch)
     for start in (1,):
         biased = acc.copy()
@@ -194,11 +195,11 @@ def test_bias_step_is_absorbed_by_the_offset(record):
         assert np.sqrt(np.mean((out[after:, 0] - ref[after:, 0]) ** 2)) < 0.01
 
 
-@pytest.mark.parametrize("model,corr", [("peaks", 0.98), ("band", 0.99)])   # measured 0.987, 0.995
+@pytest.mark.parametrize("model,corr", [("peaks", 0.98), ("band", 0.99)])   # measured 0.986, 0.994
 def test_two_spectral_peaks_are_tracked(model, corr):
     """Swell (Tp 14 s) plus wind sea (Tp 5 s) on a heave-following buoy: the paper's model puts
-    a mode on each peak; both models track heave."""
-    t = np.arange(1, int(900 / DT) + 1) * DT
+    a mode on each peak; both models track heave (8 minutes, scored after 2)."""
+    t = np.arange(1, int(480 / DT) + 1) * DT
     z, a = np.zeros_like(t), np.zeros_like(t)
     for hs, tp, stream in ((1.0, 14.0, 0), (1.5, 5.0, 1)):
         f = realise(SeaState(hs=hs, tp=tp, seed=5), stream)

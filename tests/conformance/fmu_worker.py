@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import sys
 import tempfile
@@ -482,4 +483,8 @@ if __name__ == "__main__":
     case, fmu_name, fmu_dir, work_dir = sys.argv[1:5]
     result = CASES[case](fmu_name, Path(fmu_dir), Path(work_dir))
     sys.stdout.flush()
-    print("\n" + json.dumps(result))
+    print("\n" + json.dumps(result), flush=True)
+    # Leave without interpreter finalisation and C++ static destructors: under load about one
+    # run in 30 with several pythonfmu 0.7.0 instances aborts there ("corrupted double-linked
+    # list", after every FMU was freed), which says nothing about the case (README, known issues).
+    os._exit(0)
