@@ -152,7 +152,6 @@ class Feed:
         self.real = {v.name: rec[:, source(v.name)] for v in inst.real_inputs}
         self.bool = {v.name: rec[:, source(v.name)] > 0.5 for v in inst.bool_inputs}
         self.truth_cog = rec[:, [names.index(f"truth.cog.{a}") for a in "ned"]]
-        self.steps = rec.shape[0]
 
     def at(self, k: int) -> tuple[dict[str, float], dict[str, bool]]:
         return ({n: float(x[k]) for n, x in self.real.items()}, {n: bool(x[k]) for n, x in self.bool.items()})

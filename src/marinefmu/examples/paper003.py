@@ -71,10 +71,10 @@ def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
     a_pt = rec["truth.point_acc.d"]  # at the point the baseline gets the exact acceleration: its best case
     hp = {}
     for where, acc in (("imu", a_imu), ("point", a_pt)):
-        cutoff = min(HP_CUTOFFS, key=lambda c: _rms(highpass_double_integration(acc, DT, c)[k0:] - truth[where][k0:]))
-        hp[where] = highpass_double_integration(acc, DT, cutoff)
-        hp[f"rms_{where}"] = _rms(hp[where][k0:] - truth[where][k0:])
-        hp[f"cutoff_{where}"] = cutoff
+        tried = {c: highpass_double_integration(acc, DT, c) for c in HP_CUTOFFS}
+        rms = {c: _rms(z[k0:] - truth[where][k0:]) for c, z in tried.items()}
+        cutoff = min(rms, key=rms.get)
+        hp[where], hp[f"rms_{where}"], hp[f"cutoff_{where}"] = tried[cutoff], rms[cutoff], cutoff
     runs["high-pass"] = hp
     return {"sea": (hs, tp), "t": (np.arange(len(a_imu)) + 1) * DT, "truth": truth, "runs": runs,
             "std_imu": float(np.std(truth["imu"][k0:])), "std_point": float(np.std(truth["point"][k0:]))}
