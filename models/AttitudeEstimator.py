@@ -37,7 +37,7 @@ else:
         def _step(self, t, dt):
             i = self.io.inputs
             r = self.model.step((i["gyro.x"], i["gyro.y"], i["gyro.z"]), (i["acc.x"], i["acc.y"], i["acc.z"]), dt)
-            self.io.warn(r.warning, t)
+            self.io.warn(r.warning, t, r.valid)
             self.io.set_outputs([r.roll, r.pitch, r.yaw, *r.q, *r.gyro_bias], [r.valid])
 
         def _get_fmu_state(self):

@@ -36,7 +36,7 @@ else:
             i = self.io.inputs
             r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), (i["gyro.x"], i["gyro.y"], i["gyro.z"]), dt,
                                 (i["roll"], i["pitch"], i["yaw"]))
-            self.io.warn(r.warning, t)
+            self.io.warn(r.warning, t, r.valid)
             self.io.set_outputs([*r.offset, *r.offset_std, *r.offset_mean, *r.cr, *r.acc_cr, *r.acc_cr_n, *r.euler, r.delay],
                                 [r.valid, r.settled])
 

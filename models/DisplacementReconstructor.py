@@ -43,7 +43,7 @@ else:
         def _step(self, t, dt):
             i = self.io.inputs
             r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), (i["roll"], i["pitch"], i["yaw"]), dt)
-            self.io.warn(r.warning, t)
+            self.io.warn(r.warning, t, r.valid)
             self.io.set_outputs([*r.disp, *r.vel, *r.centred_disp, *r.centred_vel, r.delay, r.latency], [r.valid])
 
         def _get_fmu_state(self):

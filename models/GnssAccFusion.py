@@ -50,7 +50,7 @@ else:
                 self.last_fix = ant
             r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), np.array(ant) if new else None, dt,
                                 (i["gyro.x"], i["gyro.y"], i["gyro.z"]))
-            self.io.warn(r.warning, t)
+            self.io.warn(r.warning, t, r.valid)
             self.io.set_outputs([*r.pos, *r.vel, *r.pos_std, *r.euler, *r.acc_n, *r.acc_bias, r.residual],
                                 [r.valid, r.fix == "accepted"])
 

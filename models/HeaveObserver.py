@@ -35,7 +35,7 @@ else:
         def _step(self, t, dt):
             i = self.io.inputs
             r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), i["roll"], i["pitch"], dt)
-            self.io.warn(r.warning, t)
+            self.io.warn(r.warning, t, r.valid)
             self.io.set_outputs([r.heave, r.heave_rate, r.point_heave, r.point_heave_rate, r.delayed_heave,
                                  r.delayed_heave_rate, r.delayed_point_heave, r.delay, r.offset, r.peak_period],
                                 [r.modes, r.valid, r.delayed_valid])

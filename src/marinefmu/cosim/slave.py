@@ -176,8 +176,12 @@ class SlaveIO:
         self.slave.log(f"{self.slave.instance_name}: {self.error}; the FMU cannot step", Fmi2Status.error)
         return False
 
-    def warn(self, message: str | None, time: float) -> None:
+    def warn(self, message: str | None, time: float, valid: bool = False) -> None:
         """Report a rejected sample (``message``) or a good one (None) as an FMU warning.
+
+        ``valid`` is the estimator's ``valid`` output on this step: a rejected sample says
+        "holding/coasting, valid = false"; an event the estimator handled with a valid output
+        (a GNSS re-initialisation) says "valid = true".
 
         A run of identical rejections is logged once when it starts and once, with its
         length, when it ends, so a long sensor outage is visible without flooding the log.
@@ -189,7 +193,8 @@ class SlaveIO:
             self.slave.log(f"{self.slave.instance_name}: t = {time:.4f} s: {self._warning} ended after {self._repeats + 1} step(s)",
                            Fmi2Status.warning)
         if message is not None:
-            self.slave.log(f"{self.slave.instance_name}: t = {time:.4f} s: {message}; holding/coasting, valid = false",
+            consequence = "valid = true" if valid else "holding/coasting, valid = false"
+            self.slave.log(f"{self.slave.instance_name}: t = {time:.4f} s: {message}; {consequence}",
                            Fmi2Status.warning)
         self._warning, self._repeats = message, 0
 
