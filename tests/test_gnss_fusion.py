@@ -180,8 +180,8 @@ def test_a_20_m_jump_is_gated_out():
 def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 120 s window and 120 s of
     anchors before it). Real time with ``coast="band"`` (default): measured max per axis
-    2-4 / 7.4-13.6 / 4.5-7.3 cm north / east / down over seeds 1-3 (east: roll from the 8 m
-    antenna baseline), against metres for the inertial coast (README); bound 15 cm per axis.
+    2-4 / 7.4-13.6 / 4.5-7.3 cm north / east / down over seeds 1-3 (east: the band observer's
+    response on the sway, README), against metres for the inertial coast (README); bound 15 cm per axis.
     RTS-smoothed through the gap: measured max 1.4-3.0 / 3.3-9.0 / 3.2-4.6 cm, so the 10 cm
     goal holds on every axis (bound 10 cm). Back within 5 cm (3-D) 5 s after the fixes
     return, and valid throughout (within max_coast)."""

@@ -471,6 +471,14 @@ class HeaveObserver:
         self._variance = variance
         return True
 
+    def response(self, omega: Any) -> np.ndarray | None:
+        """Heave response H(ω) of the current model (:meth:`.BankModel.heave_response`): the
+        estimate of a noise-free sinusoidal heave at ω [rad/s] is H(ω) times the truth.
+        None before the first spectrum."""
+        if self.model is None or self.dt is None:
+            return None
+        return self.model.heave_response(np.asarray(omega, dtype=float), self.dt)
+
     def _build(self, omega: np.ndarray, variance: np.ndarray | None) -> BankModel:
         """The observer model for mode frequencies ``omega`` (and, for the band, element variances)."""
         p = self.params
