@@ -180,9 +180,9 @@ def test_a_20_m_jump_is_gated_out():
 def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 120 s window and 120 s of
     anchors before it). Real time with ``coast="band"`` (default): measured max per axis
-    2-4 / 7.4-13.6 / 4.5-7.3 cm north / east / down over seeds 1-3 (east: the band observer's
-    response on the sway, README), against metres for the inertial coast (README); bound 15 cm per axis.
-    RTS-smoothed through the gap: measured max 1.4-3.0 / 3.3-9.0 / 3.2-4.6 cm, so the 10 cm
+    1.8-4.3 / 4.9-11.5 / 3.9-6.0 cm north / east / down over seeds 1-3 (east: the band observer's
+    response on the sway, README), against metres for the inertial coast (README); bound 12 cm per axis.
+    RTS-smoothed through the gap: measured max 1.3-3.0 / 3.5-9.4 / 3.3-4.7 cm, so the 10 cm
     goal holds on every axis (bound 10 cm). Back within 5 cm (3-D) 5 s after the fixes
     return, and valid throughout (within max_coast)."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
@@ -192,8 +192,8 @@ def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     k = int(300.0 / paper001.DT)
     gap = slice(k, k + 3000)
     assert np.all(np.isfinite(r["pos"])) and np.all(r["valid"][gap])
-    assert np.sum(r["fix"][gap] == "wave") >= 28   # a pseudo-fix a second from 2 s into the gap
-    assert np.all(np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0) < 0.15)
+    assert np.sum(r["fix"][gap] == "wave") >= 279   # a pseudo-fix every 0.1 s from 2 s into the gap
+    assert np.all(np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0) < 0.12)
     assert np.all(np.max(np.abs(r["pos_smooth"][gap] - rec["cog"][gap]), axis=0) < 0.10)
     after = slice(int(335.0 / paper001.DT), None)
     assert np.max(np.linalg.norm(r["pos"][after] - rec["cog"][after], axis=1)) < 0.05

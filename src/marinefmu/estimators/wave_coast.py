@@ -21,7 +21,7 @@ Method, per NED axis:
 Its error is the band observer's wave-frequency error plus the line's extrapolation error: a
 vessel that manoeuvres during the gap breaks the assumption (use ``coast="inertial"`` in
 :class:`~.gnss_fusion.FusionParams` then). :class:`~.gnss_fusion.GnssAccFusion` feeds the
-coast position to its Kalman filter as a pseudo-fix once a second while GNSS is missing.
+coast position to its Kalman filter as a pseudo-fix every 0.1 s while GNSS is missing.
 
 The horizontal observers use ``offset_noise`` :data:`HORIZONTAL_OFFSET_NOISE`, ten times the
 heave default: the horizontal a_n carries g × the attitude error of the antenna fixes (about
