@@ -96,14 +96,16 @@ def pytest_pyfunc_call(pyfuncitem):
     import subprocess
     import sys
 
-    if pyfuncitem.get_closest_marker("isolated") is None or os.environ.get(_CHILD_FLAG):
+    marker = pyfuncitem.get_closest_marker("isolated")
+    if marker is None or os.environ.get(_CHILD_FLAG):
         return None
+    timeout = marker.kwargs.get("timeout", ISOLATED_TIMEOUT)   # isolated(timeout=…) for a long one
     env = {**os.environ, _CHILD_FLAG: "1"}
     cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--no-header", pyfuncitem.nodeid]
     try:
-        done = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=ISOLATED_TIMEOUT)
+        done = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired as exc:
-        pytest.fail(f"isolated test timed out after {ISOLATED_TIMEOUT:.0f} s\n{(exc.stdout or b'')[-4000:]!r}", pytrace=False)
+        pytest.fail(f"isolated test timed out after {timeout:.0f} s\n{(exc.stdout or b'')[-4000:]!r}", pytrace=False)
     if done.returncode != 0:
         how = f"killed by signal {-done.returncode}" if done.returncode < 0 else f"exit code {done.returncode}"
         pytest.fail(f"isolated test failed in its subprocess ({how}):\n{done.stdout[-6000:]}\n{done.stderr[-3000:]}",

@@ -115,7 +115,9 @@ _VALUE_TAG = {bool: "Boolean", int: "Integer", float: "Real", str: "String"}
 
 
 def write_system_structure(dest: Path, step: float, simulators: dict[str, tuple[Path, dict]],
-                           group_connections: list[tuple[tuple[str, str], tuple[str, str]]]) -> Path:
+                           group_connections: list[tuple[tuple[str, str], tuple[str, str]]],
+                           variable_connections: list[tuple[tuple[str, str], tuple[str, str]]] = (),
+                           step_sizes: dict[str, float] | None = None) -> Path:
     """Write an ``OspSystemStructure.xml`` (OSP-IS 1.0) that libcosim loads directly.
 
     Parameters
@@ -130,6 +132,10 @@ def write_system_structure(dest: Path, step: float, simulators: dict[str, tuple[
     group_connections : list
         ((simulator, output group), (simulator, input group)) pairs, connected variable by
         variable in group order.
+    variable_connections : list
+        ((simulator, output variable), (simulator, input variable)) pairs.
+    step_sizes : dict, optional
+        Simulator name -> its own step [s] (a multiple of ``step``); others step at ``step``.
     """
     ET.register_namespace("", SYSTEM_NAMESPACE)
 
@@ -144,7 +150,10 @@ def write_system_structure(dest: Path, step: float, simulators: dict[str, tuple[
     sub(root, "Algorithm", text="fixedStep")
     sims = sub(root, "Simulators")
     for name, (fmu, values) in simulators.items():
-        sim = sub(sims, "Simulator", {"name": name, "source": Path(fmu).resolve().as_uri()})
+        attrib = {"name": name, "source": Path(fmu).resolve().as_uri()}
+        if step_sizes and name in step_sizes:
+            attrib["stepSize"] = repr(float(step_sizes[name]))
+        sim = sub(sims, "Simulator", attrib)
         initial = sub(sim, "InitialValues")
         for variable, value in values.items():
             v = sub(initial, "InitialValue", {"variable": variable})
@@ -155,6 +164,10 @@ def write_system_structure(dest: Path, step: float, simulators: dict[str, tuple[
         c = sub(connections, "VariableGroupConnection")
         sub(c, "VariableGroup", {"simulator": sim_a, "name": group_a})
         sub(c, "VariableGroup", {"simulator": sim_b, "name": group_b})
+    for (sim_a, var_a), (sim_b, var_b) in variable_connections:
+        c = sub(connections, "VariableConnection")
+        sub(c, "Variable", {"simulator": sim_a, "name": var_a})
+        sub(c, "Variable", {"simulator": sim_b, "name": var_b})
     ET.indent(root)
     dest.write_bytes(ET.tostring(root, encoding="utf-8", xml_declaration=True))
     return dest

@@ -10,6 +10,7 @@ fixed base step or per-component rates, so those are stored as annotations of ty
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -140,8 +141,13 @@ def _typed(value: Value) -> tuple[str, str]:
     return "String", str(value)
 
 
-def write_ssd(system: SystemDescription, path: str | Path) -> Path:
-    """Write ``system`` as an SSP 1.0 ``SystemStructure.ssd`` file; return its path."""
+def write_ssd(system: SystemDescription, path: str | Path, types: Mapping[tuple[str, str], str] | None = None) -> Path:
+    """Write ``system`` as an SSP 1.0 ``SystemStructure.ssd`` file; return its path.
+
+    ``types`` maps (component, connector) to its FMI type (``Real``, ``Integer``, ``Boolean``,
+    ``String``); connectors not in it are written as ``Real``.
+    """
+    types = types or {}
     root = ET.Element(_q("ssd", "SystemStructureDescription"), {"version": "1.0", "name": system.name})
     sys_el = ET.SubElement(root, _q("ssd", "System"), {"name": system.name})
     connected: dict[str, dict[str, str]] = {c.name: {} for c in system.components}
@@ -156,7 +162,7 @@ def write_ssd(system: SystemDescription, path: str | Path) -> Path:
             conns = ET.SubElement(ce, _q("ssd", "Connectors"))
             for var, kind in connected[comp.name].items():
                 c = ET.SubElement(conns, _q("ssd", "Connector"), {"name": var, "kind": kind})
-                ET.SubElement(c, _q("ssc", "Real"))
+                ET.SubElement(c, _q("ssc", types.get((comp.name, var), "Real")))
         if comp.parameters:
             binding = ET.SubElement(ET.SubElement(ce, _q("ssd", "ParameterBindings")), _q("ssd", "ParameterBinding"))
             pset = ET.SubElement(ET.SubElement(binding, _q("ssd", "ParameterValues")), _q("ssv", "ParameterSet"),
@@ -235,3 +241,58 @@ def read_ssd(path: str | Path) -> SystemDescription:
         stop_time=float(exp.get("stopTime", 600.0)) if exp is not None else 600.0,
         start_time=float(exp.get("startTime", 0.0)) if exp is not None else 0.0,
     )
+
+
+def write_ssp(system: SystemDescription, fmu_dir: str | Path, dest: str | Path) -> Path:
+    """Write an SSP 1.0 package: ``SystemStructure.ssd`` plus every FMU under ``resources/``.
+
+    Component sources are resolved against ``fmu_dir`` (unless absolute) and become
+    ``resources/<file>.fmu`` in the package; connector types are read from the FMUs'
+    model descriptions (FMPy), so Boolean connections are typed Boolean.
+    """
+    import tempfile
+    import zipfile
+
+    from fmpy import read_model_description
+
+    fmu_dir, dest = Path(fmu_dir), Path(dest)
+    files: dict[str, Path] = {}
+    comps = []
+    types: dict[tuple[str, str], str] = {}
+    for c in system.components:
+        src = Path(c.source) if Path(c.source).is_absolute() else fmu_dir / c.source
+        if not src.is_file():
+            raise ParameterError(f"component {c.name}: FMU {src} not found (run `marinefmu build`)")
+        files[f"resources/{src.name}"] = src
+        comps.append(Component(c.name, f"resources/{src.name}", c.parameters, c.rate))
+        variables = {v.name: v.type for v in read_model_description(str(src)).modelVariables}
+        for con in system.connections:
+            for name, var in ((con.start, con.start_var), (con.end, con.end_var)):
+                if name == c.name and var in variables:
+                    types[(name, var)] = variables[var]
+    packaged = SystemDescription(system.name, tuple(comps), system.connections, system.step, system.stop_time,
+                                 system.start_time)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        ssd = write_ssd(packaged, Path(tmp) / "SystemStructure.ssd", types)
+        with zipfile.ZipFile(dest, "w", zipfile.ZIP_DEFLATED) as z:
+            z.write(ssd, "SystemStructure.ssd")
+            for arcname, src in files.items():
+                z.write(src, arcname)
+    return dest
+
+
+def read_ssp(path: str | Path, into: str | Path) -> SystemDescription:
+    """Unpack an ``.ssp`` into the folder ``into`` and read its ``SystemStructure.ssd``; the
+    component sources are returned as absolute paths into that folder."""
+    import zipfile
+
+    path, into = Path(path), Path(into)
+    try:
+        with zipfile.ZipFile(path) as z:
+            z.extractall(into)
+    except (OSError, zipfile.BadZipFile) as exc:
+        raise ParameterError(f"{path}: not a readable SSP package: {exc}") from exc
+    system = read_ssd(into / "SystemStructure.ssd")
+    comps = tuple(Component(c.name, str((into / c.source).resolve()), c.parameters, c.rate) for c in system.components)
+    return SystemDescription(system.name, comps, system.connections, system.step, system.stop_time, system.start_time)
