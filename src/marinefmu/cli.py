@@ -7,6 +7,7 @@ Examples
     marinefmu build
     marinefmu simulate default --duration 120 --out results/default
     marinefmu simulate my_scenario.toml
+    marinefmu simulate results/system/system.ssp
     marinefmu bench
     marinefmu example --list
     marinefmu example paper001-fig7 --out results/examples
@@ -30,13 +31,21 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from .cosim.ssp import write_ssd
+    from .cosim.libcosim_runner import write_osp_system
+    from .cosim.ssp import read_ssp, write_ssd, write_ssp
     from .cosim.system import SystemRunner, save_csv
     from .report import plot_vessel, vessel_components, vessel_summary
-    from .scenarios import load_scenario
+    from .scenarios import Scenario, load_scenario
 
-    scenario = load_scenario(args.scenario)
-    fmu_dir = Path(args.fmus) if args.fmus else None
+    package = str(args.scenario).endswith(".ssp")
+    if package:   # an SSP package: its own FMUs, unpacked next to the results
+        out = Path(args.out or f"results/{Path(args.scenario).stem}")
+        system = read_ssp(args.scenario, out / "ssp")
+        scenario = Scenario(system.name, f"SSP package {args.scenario}", system.stop_time - system.start_time,
+                            system.step, system, None, str(args.scenario))
+    else:
+        scenario = load_scenario(args.scenario)
+    fmu_dir = Path(args.fmus) if args.fmus else (Path(".") if package else None)
     if fmu_dir is None:
         from .cosim.build import build_all, repo_root
 
@@ -50,6 +59,10 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     ssd = write_ssd(scenario.system, out / "SystemStructure.ssd")
     print(f"scenario {scenario.name}: {scenario.description}")
     print(f"  {len(scenario.system.components)} component(s), {duration:g} s at {scenario.step:g} s; system file {ssd}")
+    if not package:
+        ssp = write_ssp(scenario.system, fmu_dir, out / f"{scenario.name}.ssp")
+        osp = write_osp_system(scenario.system, fmu_dir, out / "OspSystemStructure.xml")
+        print(f"  SSP package {ssp} (run it with `marinefmu simulate {ssp}`); OSP libcosim system {osp}")
     runner = SystemRunner(scenario.system, fmu_dir)
     t0 = time.perf_counter()
     result = runner.run(scenario.system.start_time + duration, record=scenario.record,
@@ -118,8 +131,9 @@ def main(argv: list[str] | None = None) -> int:
     b = sub.add_parser("build", help="build models/*.py into fmus/*.fmu and validate them")
     b.add_argument("--force", action="store_true", help="rebuild even if nothing changed")
     b.set_defaults(func=_cmd_build)
-    s = sub.add_parser("simulate", help="run a scenario (TOML file or built-in name) and write CSV and PNG plots")
-    s.add_argument("scenario", help="scenario TOML file, or a built-in name such as 'default'")
+    s = sub.add_parser("simulate", help="run a scenario (TOML file, built-in name or .ssp package) and write CSV, "
+                                        "PNG plots, the SSP package and the OSP libcosim system file")
+    s.add_argument("scenario", help="scenario TOML file, a built-in name such as 'default' or 'system', or an .ssp package")
     s.add_argument("--duration", type=float, help="simulated time [s] (default: the scenario's)")
     s.add_argument("--out", help="output folder (default results/<scenario name>)")
     s.add_argument("--fmus", help="folder holding the FMUs (default: build into the checkout's fmus/)")
