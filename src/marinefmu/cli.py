@@ -76,6 +76,14 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         print(f"  summary of {comp}:")
         for k, v in vessel_summary(result, comp).items():
             print(f"    {k:28s} {v:.6g}")
+    vessels = vessel_components(result)
+    if vessels:
+        from .scoring import score
+
+        for comp, metrics in score(result, scenario.system, vessels[0]).items():
+            print(f"  accuracy of {comp} against {vessels[0]}'s truth:")
+            for k, v in metrics.items():
+                print(f"    {k:28s} {v:.6g}")
     problems = [m for m in runner.messages if m.status in ("WARNING", "ERROR", "FATAL")]
     for m in problems:
         print(f"  FMU {m.status.lower()}: {m.instance}: {m.text}")

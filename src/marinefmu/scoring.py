@@ -1,0 +1,101 @@
+"""Accuracy of the estimator components of a system run against a VesselMotion component's truth.
+
+Each estimator is scored from ``settle`` s after its ``valid`` output first went true, on the
+samples where it is valid, against the matching ``truth.*`` outputs recorded in the same run:
+
+=========================  ====================================================================
+FMU                         metrics (RMS errors)
+=========================  ====================================================================
+AttitudeEstimator           ``roll_deg``, ``pitch_deg`` (truth.roll, truth.pitch)
+GnssAccFusion               ``pos_n_cm``, ``pos_e_cm``, ``pos_d_cm`` (truth.cog)
+HeaveObserver               ``heave_cm`` (truth.imu.d), ``point_heave_cm`` (truth.point.d), each
+                            about its mean over the scored span as the observer has no mean;
+                            ``heave_std_cm`` of the truth for scale
+CentreOfRotation            ``cr_x_m``, ``cr_y_m``, ``cr_z_m`` (truth.cr, when the vessel runs in
+                            the independent-rotation-centre mode and ``truth.cr.defined``)
+=========================  ====================================================================
+
+Every estimator also gets ``valid_fraction`` (of the whole run) and ``scored_s`` (the length of
+the span scored [s]). Other components, and metrics whose fields were not recorded, are left out.
+The estimator's lever arms must match the vessel's (a HeaveObserver's ``point`` is the vessel's
+point relative to its IMU), as in the built-in scenario ``system``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .cosim.ssp import SystemDescription
+
+
+def _rms(e: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(e ** 2))) if e.size else math.nan
+
+
+def _span(result: np.ndarray, comp: str, settle: float) -> np.ndarray:
+    """Boolean mask: valid, and at least ``settle`` s after valid first went true."""
+    valid = np.asarray(result[f"{comp}.valid"], dtype=bool)
+    if not valid.any():
+        return valid
+    t = np.asarray(result["time"], dtype=float)
+    return valid & (t >= t[np.argmax(valid)] + settle)
+
+
+def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: float = 60.0) -> dict[str, dict[str, float]]:
+    """Metrics of every estimator component of ``system`` (module docstring).
+
+    Parameters
+    ----------
+    result : numpy.ndarray
+        Structured array of :meth:`~.cosim.system.SystemRunner.run` (``time`` and
+        ``component.variable`` fields).
+    system : SystemDescription
+        The system that produced it (component FMU types come from the sources).
+    vessel : str
+        Name of the VesselMotion component whose truth is the reference.
+    settle : float
+        Time after ``valid`` first went true that is not scored [s].
+
+    Returns
+    -------
+    dict
+        Component name -> metric name -> value.
+    """
+    fields = set(result.dtype.names)
+    t = np.asarray(result["time"], dtype=float)
+
+    def has(*names: str) -> bool:
+        return all(n in fields for n in names)
+
+    def f(name: str) -> np.ndarray:
+        return np.asarray(result[name], dtype=float)
+
+    out: dict[str, dict[str, float]] = {}
+    for comp in system.components:
+        kind = comp.source.replace("\\", "/").rsplit("/", 1)[-1].removesuffix(".fmu")
+        if f"{comp.name}.valid" not in fields or comp.name == vessel:
+            continue
+        m = _span(result, comp.name, settle)
+        row = {"valid_fraction": float(np.mean(np.asarray(result[f"{comp.name}.valid"], dtype=bool))),
+               "scored_s": float(np.sum(m) * (t[1] - t[0])) if len(t) > 1 else 0.0}
+        c, v = comp.name, vessel
+        if kind == "AttitudeEstimator" and has(f"{c}.roll", f"{v}.truth.roll"):
+            for a in ("roll", "pitch"):
+                row[f"{a}_deg"] = math.degrees(_rms(f(f"{c}.{a}")[m] - f(f"{v}.truth.{a}")[m]))
+        elif kind == "GnssAccFusion" and has(f"{c}.pos.n", f"{v}.truth.cog.n"):
+            for a in "ned":
+                row[f"pos_{a}_cm"] = 100.0 * _rms(f(f"{c}.pos.{a}")[m] - f(f"{v}.truth.cog.{a}")[m])
+        elif kind == "HeaveObserver" and has(f"{c}.heave", f"{v}.truth.imu.d"):
+            truth = f(f"{v}.truth.imu.d")[m]
+            row["heave_cm"] = 100.0 * _rms(f(f"{c}.heave")[m] - (truth - truth.mean()))
+            row["heave_std_cm"] = 100.0 * float(np.std(truth)) if truth.size else math.nan
+            if has(f"{c}.point.heave", f"{v}.truth.point.d"):
+                point = f(f"{v}.truth.point.d")[m]
+                row["point_heave_cm"] = 100.0 * _rms(f(f"{c}.point.heave")[m] - (point - point.mean()))
+        elif kind == "CentreOfRotation" and has(f"{c}.cr.x", f"{v}.truth.cr.x", f"{v}.truth.cr.defined"):
+            m &= np.asarray(result[f"{v}.truth.cr.defined"], dtype=bool)
+            for a in "xyz":
+                row[f"cr_{a}_m"] = _rms(f(f"{c}.cr.{a}")[m] - f(f"{v}.truth.cr.{a}")[m])
+        out[comp.name] = row
+    return out
