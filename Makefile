@@ -17,7 +17,7 @@ fmus: $(STAMP)
 	$(PY) build_fmus.py
 
 demo: fmus
-	$(VENV)/bin/marinefmu simulate default --out results/default
+	$(VENV)/bin/marinefmu simulate system --out results/system
 
 test: fmus
 	$(PY) -m pytest -q

@@ -77,13 +77,21 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         for k, v in vessel_summary(result, comp).items():
             print(f"    {k:28s} {v:.6g}")
     vessels = vessel_components(result)
+    scores = {}
     if vessels:
         from .scoring import score
 
-        for comp, metrics in score(result, scenario.system, vessels[0]).items():
+        scores = score(result, scenario.system, vessels[0])
+        for comp, metrics in scores.items():
             print(f"  accuracy of {comp} against {vessels[0]}'s truth:")
             for k, v in metrics.items():
                 print(f"    {k:28s} {v:.6g}")
+    if scores:
+        from .system_report import write_report
+
+        page = write_report(result, scenario.system, scores, vessels[0], out, f"marinefmu: scenario {scenario.name}",
+                            scenario.description)
+        print(f"  report {page}")
     problems = [m for m in runner.messages if m.status in ("WARNING", "ERROR", "FATAL")]
     for m in problems:
         print(f"  FMU {m.status.lower()}: {m.instance}: {m.text}")
