@@ -46,6 +46,11 @@ def test_simulate_reports_a_bad_scenario_with_exit_code_2(tmp_path, capsys):
     assert "sea.hs = -2.0 is out of range" in err
 
 
+def test_simulate_reports_a_missing_ssp_package_with_exit_code_2(tmp_path, capsys):
+    assert main(["simulate", str(tmp_path / "none.ssp"), "--out", str(tmp_path / "o"), "--no-progress"]) == 2
+    assert "none.ssp: not a readable SSP package" in capsys.readouterr().err
+
+
 def test_console_script_is_installed():
     out = subprocess.run([sys.executable, "-m", "marinefmu.cli", "--help"], capture_output=True, text=True, check=True).stdout
     assert "simulate" in out and "build" in out and "bench" in out

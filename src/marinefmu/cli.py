@@ -54,7 +54,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     duration = scenario.duration if args.duration is None else args.duration
     if not duration > 0:
         raise MarineFmuError(f"--duration = {duration} is out of range: must be > 0 [s]")
-    out = Path(args.out or f"results/{scenario.name}")
+    if not package:
+        out = Path(args.out or f"results/{scenario.name}")
     out.mkdir(parents=True, exist_ok=True)
     ssd = write_ssd(scenario.system, out / "SystemStructure.ssd")
     print(f"scenario {scenario.name}: {scenario.description}")
