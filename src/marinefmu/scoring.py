@@ -36,6 +36,10 @@ def _rms(e: np.ndarray) -> float:
     return float(np.sqrt(np.mean(e ** 2))) if e.size else math.nan
 
 
+def _about_mean(x: np.ndarray) -> np.ndarray:
+    return x - x.mean() if x.size else x
+
+
 def _span(result: np.ndarray, comp: str, settle: float) -> np.ndarray:
     """Boolean mask: valid, and at least ``settle`` s after valid first went true."""
     valid = np.asarray(result[f"{comp}.valid"], dtype=bool)
@@ -91,11 +95,11 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
                 row[f"pos_{a}_cm"] = 100.0 * _rms(f(f"{c}.pos.{a}")[m] - f(f"{v}.truth.cog.{a}")[m])
         elif kind == "HeaveObserver" and has(f"{c}.heave", f"{v}.truth.imu.d"):
             truth = f(f"{v}.truth.imu.d")[m]
-            row["heave_cm"] = 100.0 * _rms(f(f"{c}.heave")[m] - (truth - truth.mean()))
+            row["heave_cm"] = 100.0 * _rms(f(f"{c}.heave")[m] - _about_mean(truth))
             row["heave_std_cm"] = 100.0 * float(np.std(truth)) if truth.size else math.nan
             if has(f"{c}.point.heave", f"{v}.truth.point.d"):
                 point = f(f"{v}.truth.point.d")[m]
-                row["point_heave_cm"] = 100.0 * _rms(f(f"{c}.point.heave")[m] - (point - point.mean()))
+                row["point_heave_cm"] = 100.0 * _rms(f(f"{c}.point.heave")[m] - _about_mean(point))
                 row["point_heave_std_cm"] = 100.0 * float(np.std(point)) if point.size else math.nan
         elif kind == "DisplacementReconstructor" and has(f"{c}.centred.disp.d", f"{c}.centred.delay", f"{v}.truth.cog.d"):
             lag = int(round(float(f(f"{c}.centred.delay")[-1]) / (t[1] - t[0]))) if len(t) > 1 else 0
@@ -104,7 +108,7 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
             for a in "ned":
                 truth = f(f"{v}.truth.cog.{a}")[k - lag]
                 est = f(f"{c}.centred.disp.{a}")[k]
-                row[f"disp_{a}_cm"] = 100.0 * _rms(est - est.mean() - (truth - truth.mean())) if k.size else math.nan
+                row[f"disp_{a}_cm"] = 100.0 * _rms(_about_mean(est) - _about_mean(truth))
         elif (kind == "CentreOfRotation" and has(f"{c}.cr.x", f"{v}.truth.cr.x", f"{v}.truth.cr.defined")
               and np.asarray(result[f"{v}.truth.cr.defined"], dtype=bool).any()):
             m &= np.asarray(result[f"{v}.truth.cr.defined"], dtype=bool)
