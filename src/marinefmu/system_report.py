@@ -109,6 +109,12 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
             ax[1].set_ylabel("error [deg]")
             ax[1].set_xlabel("time [s]")
             ax[1].legend(loc="upper right", fontsize=8)
+            settled = t >= t[0] + 60.0
+            if settled.any():     # scale to the settled error, not the start transient
+                worst = max(float(np.max(np.abs(np.degrees(g(f"{c}.{a}") - g(f"{v}.truth.{a}"))[settled])))
+                            for a in ("roll", "pitch"))
+                if math.isfinite(worst) and worst > 0:
+                    ax[1].set_ylim(-1.5 * worst, 1.5 * worst)
             out.append((f"{c}: roll and pitch, the last minute and the error over the run", _png(fig)))
         elif kind == "HeaveObserver" and f"{c}.heave" in fields:
             valid = np.asarray(result[f"{c}.valid"], dtype=bool)
