@@ -138,7 +138,9 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
 
 
 #: Parts of ``marinefmu bench``, in the order they run.
-PARTS = ("speed", "heave", "memory")
+PARTS = ("speed", "heave", "peer", "memory")
+#: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
+PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks: Hs [m], Tp [s]).
 HEAVE_SEAS = ((1.0, 6.0), (4.0, 6.0), (2.5, 9.0), (1.0, 14.0), (4.0, 14.0))
 
@@ -194,6 +196,26 @@ def heave_accuracy() -> dict[str, dict]:
     return result
 
 
+def peer_attitude(duration: float = 600.0) -> dict[str, dict]:
+    """Roll and pitch RMS errors [deg] of marinefmu's AttitudeEstimator and smsfusion's VRU on
+    the same records (:func:`marinefmu.peer.compare_attitude`), over :data:`PEER_SEAS`: the
+    ``system`` scenario's vessel, heading and IMU position, ``duration`` s, scored after 60 s."""
+    from .peer import compare_attitude
+    from .sea.motion_model import VesselMotionParams, simulate_record
+
+    result = {}
+    for name, (hs, tp) in PEER_SEAS.items():
+        flat = {"sea.hs": hs, "sea.tp": tp, "sea.heading": 2.6179938779914944, "vessel.preset": "polar_supply",
+                "imu.x": 5.0, "imu.y": 1.0, "imu.z": -3.0}
+        rec = simulate_record(VesselMotionParams.from_flat(flat), duration, 0.01)
+        r = compare_attitude(rec, 0.01)
+        result[name] = {"hs_m": hs, "tp_s": tp, **r}
+        ours, peer = r["marinefmu AttitudeEstimator"], r["smsfusion VRU"]
+        print(f"attitude, {name} (Hs {hs:g} m, Tp {tp:g} s): marinefmu {ours['roll_deg']:.3f} / {ours['pitch_deg']:.3f} deg, "
+              f"smsfusion VRU {peer['roll_deg']:.3f} / {peer['pitch_deg']:.3f} deg (roll / pitch RMS)", flush=True)
+    return result
+
+
 def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None,
                    memory_steps: int = 1_000_000, memory_cycles: int = 1000,
                    parts: tuple[str, ...] = PARTS) -> dict:
@@ -201,7 +223,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     part keeps its own date and machine, so parts can be re-measured one at a time) and print
     what they measure; return the whole file's data.
 
-    ``speed`` takes a few minutes, ``heave`` about five, ``memory`` (``memory_steps`` steps
+    ``speed`` takes a few minutes, ``heave`` about five, ``peer`` about one, ``memory`` (``memory_steps`` steps
     and ``memory_cycles`` cycles per FMU) about an hour on a 2-core machine."""
     from .cosim.build import build_all, repo_root
 
@@ -223,6 +245,8 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             data.update(speed(fmu_dir, steps), **stamp)  # the speed figures stay at the top level
         elif part == "heave":
             data["heave"] = {**stamp, "seas": heave_accuracy()}
+        elif part == "peer":
+            data["peer"] = {**stamp, "attitude": peer_attitude()}
         else:
             data["memory"] = {**stamp, "steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0,
                               "fmus": memory(fmu_dir, memory_steps, memory_cycles)}
