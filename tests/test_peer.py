@@ -19,3 +19,23 @@ def test_attitude_is_at_least_as_accurate_as_smsfusion_vru():
         assert ours[a] <= peer[a], r
         assert 0.01 < peer[a] < 1.0, r      # the peer ran and tracks (a broken run would be degrees off)
     assert ours["roll_deg"] < 0.1 and ours["pitch_deg"] < 0.1, r
+
+
+def test_gnss_aided_cog_against_smsfusion_aided_ins():
+    """Same sea, 5 Hz RTK GNSS on four antennas: GnssAccFusion (r = σ_v²Δt = 4.5e-5, as in the
+    ``system`` scenario) against AidedINS aided by the antennas' COG and heading, both told the
+    receiver's noise; COG RMS error per NED axis after 60 s. Measured on this 5-minute record
+    0.41 / 0.36 / 0.45 cm (marinefmu) against 0.53 / 1.00 / 0.47 cm (AidedINS). Horizontally
+    ours is better in every sea of ``make bench``; down it is not: over 10 minutes the peer has
+    0.33 / 0.43 cm in the calm / moderate sea against our 0.44 / 0.44 cm (README), so down is
+    bounded here by 1.1 × the peer's, not by the peer's."""
+    from marinefmu.peer import compare_gnss_aided
+
+    flat = {"sea.hs": 3.0, "sea.tp": 9.0, "sea.heading": 2.6179938779914944, "imu.x": 5.0, "imu.y": 1.0, "imu.z": -3.0,
+            "gnss.rate": 5.0}
+    r = compare_gnss_aided(simulate_record(VesselMotionParams.from_flat(flat), 300.0, 0.01), 0.01, (5.0, 1.0, -3.0),
+                           {"r": 4.5e-5})
+    ours, peer = r["marinefmu GnssAccFusion"], r["smsfusion AidedINS"]
+    assert ours["pos_n_cm"] <= peer["pos_n_cm"] and ours["pos_e_cm"] <= peer["pos_e_cm"], r
+    assert ours["pos_d_cm"] <= 1.1 * peer["pos_d_cm"], r
+    assert all(0.1 < peer[f"pos_{a}_cm"] < 3.0 for a in "ned"), r     # the peer ran and tracks

@@ -196,23 +196,29 @@ def heave_accuracy() -> dict[str, dict]:
     return result
 
 
-def peer_attitude(duration: float = 600.0) -> dict[str, dict]:
-    """Roll and pitch RMS errors [deg] of marinefmu's AttitudeEstimator and smsfusion's VRU on
-    the same records (:func:`marinefmu.peer.compare_attitude`), over :data:`PEER_SEAS`: the
-    ``system`` scenario's vessel, heading and IMU position, ``duration`` s, scored after 60 s."""
-    from .peer import compare_attitude
+def peer_comparison(duration: float = 600.0) -> dict[str, dict]:
+    """marinefmu beside smsfusion on the same records (:mod:`marinefmu.peer`) over
+    :data:`PEER_SEAS`: the ``system`` scenario's vessel, heading, IMU position and 5 Hz GNSS,
+    ``duration`` s, scored after 60 s. Roll and pitch RMS [deg]: AttitudeEstimator against VRU;
+    COG RMS per axis [cm]: GnssAccFusion (r = σ_v²·Δt = 4.5e-5 for 1.5 cm at 5 Hz, as in the
+    ``system`` scenario) against AidedINS told the same receiver noise."""
+    from .peer import compare_attitude, compare_gnss_aided
     from .sea.motion_model import VesselMotionParams, simulate_record
 
+    imu = (5.0, 1.0, -3.0)
     result = {}
     for name, (hs, tp) in PEER_SEAS.items():
         flat = {"sea.hs": hs, "sea.tp": tp, "sea.heading": 2.6179938779914944, "vessel.preset": "polar_supply",
-                "imu.x": 5.0, "imu.y": 1.0, "imu.z": -3.0}
+                "imu.x": imu[0], "imu.y": imu[1], "imu.z": imu[2], "gnss.rate": 5.0}
         rec = simulate_record(VesselMotionParams.from_flat(flat), duration, 0.01)
-        r = compare_attitude(rec, 0.01)
-        result[name] = {"hs_m": hs, "tp_s": tp, **r}
-        ours, peer = r["marinefmu AttitudeEstimator"], r["smsfusion VRU"]
-        print(f"attitude, {name} (Hs {hs:g} m, Tp {tp:g} s): marinefmu {ours['roll_deg']:.3f} / {ours['pitch_deg']:.3f} deg, "
-              f"smsfusion VRU {peer['roll_deg']:.3f} / {peer['pitch_deg']:.3f} deg (roll / pitch RMS)", flush=True)
+        att, cog = compare_attitude(rec, 0.01), compare_gnss_aided(rec, 0.01, imu, {"r": 4.5e-5})
+        result[name] = {"hs_m": hs, "tp_s": tp, "attitude_deg": att, "cog_cm": cog}
+        ours, peer = att["marinefmu AttitudeEstimator"], att["smsfusion VRU"]
+        print(f"{name} (Hs {hs:g} m, Tp {tp:g} s): roll / pitch RMS marinefmu {ours['roll_deg']:.3f} / "
+              f"{ours['pitch_deg']:.3f} deg, smsfusion VRU {peer['roll_deg']:.3f} / {peer['pitch_deg']:.3f} deg", flush=True)
+        ours, peer = cog["marinefmu GnssAccFusion"], cog["smsfusion AidedINS"]
+        print(f"    COG N / E / D RMS marinefmu GnssAccFusion " + " / ".join(f"{ours[f'pos_{a}_cm']:.2f}" for a in "ned")
+              + " cm, smsfusion AidedINS " + " / ".join(f"{peer[f'pos_{a}_cm']:.2f}" for a in "ned") + " cm", flush=True)
     return result
 
 
@@ -246,7 +252,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
         elif part == "heave":
             data["heave"] = {**stamp, "seas": heave_accuracy()}
         elif part == "peer":
-            data["peer"] = {**stamp, "attitude": peer_attitude()}
+            data["peer"] = {**stamp, "seas": peer_comparison()}
         else:
             data["memory"] = {**stamp, "steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0,
                               "fmus": memory(fmu_dir, memory_steps, memory_cycles)}

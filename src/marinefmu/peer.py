@@ -8,7 +8,14 @@ y starboard, z down, specific force (at rest f = [0, 0, −g]). ``VRU.update`` c
 pseudo-aiding and then projects ahead with the sample; its state after sample k is compared
 with the truth at t_k (a one-sample shift measures 0.0001° worse on the ``system`` sea).
 
-:func:`compare_attitude` scores it and :class:`~.estimators.attitude.AttitudeEstimator` on one
+
+:func:`aided_ins_cog` runs ``smsfusion.AidedINS`` (the full aided INS, MEKF) aided at every
+GNSS epoch by what the four antennas give: the COG position (:func:`~.estimators.gnss_fusion.
+antenna_attitude`, as its lever arm from the IMU) and the heading; warm-started from the first
+epoch. Its IMU position is moved to the COG with its own attitude, so it estimates what
+:class:`~.estimators.gnss_fusion.GnssAccFusion` estimates.
+
+:func:`compare_attitude` and :func:`compare_gnss_aided` score marinefmu and the peer on one
 VesselMotion record against the truth.
 """
 from __future__ import annotations
@@ -17,7 +24,7 @@ import math
 
 import numpy as np
 
-from .sea.sensors import ImuParams
+from .sea.sensors import GnssParams, ImuParams
 
 
 def vru_roll_pitch(acc: np.ndarray, gyro: np.ndarray, dt: float, imu: ImuParams | None = None) -> np.ndarray:
@@ -54,3 +61,83 @@ def compare_attitude(rec: dict[str, np.ndarray], dt: float, settle: float = 60.0
     k0 = int(round(settle / dt))
     return {name: {a: math.degrees(float(np.sqrt(np.mean((est[k0:, i] - truth[k0:, i]) ** 2))))
                    for i, a in enumerate(("roll_deg", "pitch_deg"))} for name, est in runs.items()}
+
+
+def aided_ins_cog(acc: np.ndarray, gyro: np.ndarray, gnss: np.ndarray, gnss_new: np.ndarray, dt: float,
+                  antennas: np.ndarray, imu_arm: np.ndarray, imu: ImuParams | None = None,
+                  receiver: GnssParams | None = None) -> np.ndarray:
+    """COG position [m, NED] from ``smsfusion.AidedINS`` (module docstring); (N, 3), NaN before
+    the first GNSS epoch.
+
+    Parameters
+    ----------
+    acc, gyro : numpy.ndarray
+        (N, 3) specific force [m/s²] and angular rate [rad/s], body frame.
+    gnss : numpy.ndarray
+        (N, 12) the four antenna positions, NED [m]; ``gnss_new`` (N,) marks the epochs.
+    dt : float
+        Sample interval [s].
+    antennas, imu_arm : numpy.ndarray
+        (4, 3) antenna and (3,) IMU positions relative to the COG, body frame [m].
+    imu, receiver : optional
+        Noise the filter is told (default VesselMotion's): IMU densities and bias, and the
+        receiver's σ_h, σ_v (the COG from four antennas has σ/2).
+    """
+    from scipy.spatial.transform import Rotation
+
+    try:
+        from smsfusion import AidedINS
+    except ImportError as exc:
+        raise ImportError("the peer comparison needs smsfusion: pip install smsfusion") from exc
+    from .estimators.gnss_fusion import antenna_attitude
+
+    imu, receiver = imu or ImuParams(), receiver or GnssParams()
+    arms, arm = np.asarray(antennas, dtype=float), np.asarray(imu_arm, dtype=float)
+    pos_var = np.array([receiver.sigma_h, receiver.sigma_h, receiver.sigma_v]) ** 2 / len(arms)
+    out = np.full((len(acc), 3), np.nan)
+    epochs = np.flatnonzero(gnss_new)
+    fixes = {int(k): antenna_attitude(gnss[k], arms) for k in epochs}
+    fixes = {k: f for k, f in fixes.items() if not isinstance(f, str)}
+    if not fixes:
+        return out
+    first = min(fixes)
+    x0 = np.zeros(16)
+    x0[:3] = fixes[first].cog + fixes[first].rot @ arm
+    x0[6:10] = Rotation.from_matrix(fixes[first].rot).as_quat(scalar_first=True)
+    ins = AidedINS(fs=1.0 / dt, x0_prior=x0, P0_prior=np.diag([1e-2] * 6 + [1e-4] * 3 + [1e-8] * 3),
+                   err_acc={"N": imu.acc_noise, "B": imu.acc_bias_instability, "tau_cb": imu.bias_tau},
+                   err_gyro={"N": imu.gyro_noise, "B": imu.gyro_bias_instability, "tau_cb": imu.bias_tau},
+                   lever_arm=-arm, cold_start=False)
+    head_var = (max(receiver.sigma_h, 1e-4) / float(np.ptp(arms[:, 0]) or 1.0)) ** 2   # [rad²] over the baseline
+    for k in range(first, len(acc)):
+        fix = fixes.get(k)
+        if fix is None:
+            ins.update(acc[k], gyro[k])
+        else:
+            yaw = Rotation.from_matrix(fix.rot).as_euler("ZYX")[0]
+            ins.update(acc[k], gyro[k], pos=fix.cog, pos_var=pos_var, head=yaw, head_var=head_var, head_degrees=False)
+        r = Rotation.from_euler("ZYX", ins.euler()[::-1]).as_matrix()
+        out[k] = ins.position() - r @ arm
+    return out
+
+
+def compare_gnss_aided(rec: dict[str, np.ndarray], dt: float, imu_arm: tuple[float, float, float],
+                       fusion: dict | None = None, settle: float = 60.0) -> dict[str, dict[str, float]]:
+    """COG RMS errors [cm] per NED axis after ``settle`` s of marinefmu's GnssAccFusion
+    (``fusion``: FusionParams overrides) and smsfusion's AidedINS on one VesselMotion record
+    with VesselMotion's default antennas."""
+    from dataclasses import replace
+
+    from .estimators.gnss_fusion import DEFAULT_ANTENNAS, FusionParams, fuse
+    from .sea.motion_model import stack
+
+    acc, gyro = stack(rec, "imu.acc"), stack(rec, "imu.gyro")
+    gnss = np.hstack([stack(rec, f"gnss.ant{i}", "ned") for i in range(1, 5)])
+    truth = stack(rec, "truth.cog", "ned")
+    params = replace(FusionParams(antennas=DEFAULT_ANTENNAS, acc_lever_arm=imu_arm), **(fusion or {}))
+    runs = {"marinefmu GnssAccFusion": fuse(acc, dt, gnss, rec["gnss.new"], gyro, params)["pos"],
+            "smsfusion AidedINS": aided_ins_cog(acc, gyro, gnss, rec["gnss.new"], dt, np.array(DEFAULT_ANTENNAS),
+                                                np.array(imu_arm))}
+    k0 = int(round(settle / dt))
+    return {name: {f"pos_{a}_cm": 100.0 * float(np.sqrt(np.mean((est[k0:, i] - truth[k0:, i]) ** 2)))
+                   for i, a in enumerate("ned")} for name, est in runs.items()}
