@@ -217,7 +217,7 @@ def peer_comparison(duration: float = 600.0) -> dict[str, dict]:
         print(f"{name} (Hs {hs:g} m, Tp {tp:g} s): roll / pitch RMS marinefmu {ours['roll_deg']:.3f} / "
               f"{ours['pitch_deg']:.3f} deg, smsfusion VRU {peer['roll_deg']:.3f} / {peer['pitch_deg']:.3f} deg", flush=True)
         ours, peer = cog["marinefmu GnssAccFusion"], cog["smsfusion AidedINS"]
-        print(f"    COG N / E / D RMS marinefmu GnssAccFusion " + " / ".join(f"{ours[f'pos_{a}_cm']:.2f}" for a in "ned")
+        print("    COG N / E / D RMS marinefmu GnssAccFusion " + " / ".join(f"{ours[f'pos_{a}_cm']:.2f}" for a in "ned")
               + " cm, smsfusion AidedINS " + " / ".join(f"{peer[f'pos_{a}_cm']:.2f}" for a in "ned") + " cm", flush=True)
     return result
 

@@ -27,6 +27,14 @@ import numpy as np
 from .sea.sensors import GnssParams, ImuParams
 
 
+def _smsfusion():
+    try:
+        import smsfusion
+    except ImportError as exc:  # a bench and test dependency (pyproject [dev])
+        raise ImportError("the peer comparison needs smsfusion: pip install smsfusion") from exc
+    return smsfusion
+
+
 def vru_roll_pitch(acc: np.ndarray, gyro: np.ndarray, dt: float, imu: ImuParams | None = None) -> np.ndarray:
     """Roll and pitch [rad] from ``smsfusion.VRU`` for (N, 3) specific force [m/s², body] and
     angular rate [rad/s, body] sampled every ``dt`` s; returns (N, 2).
@@ -34,12 +42,8 @@ def vru_roll_pitch(acc: np.ndarray, gyro: np.ndarray, dt: float, imu: ImuParams 
     ``imu`` gives the noise the filter is told (white-noise density, bias instability and its
     correlation time); default VesselMotion's default MEMS IMU.
     """
-    try:
-        from smsfusion import VRU
-    except ImportError as exc:  # a bench dependency (pyproject [dev])
-        raise ImportError("the peer comparison needs smsfusion: pip install smsfusion") from exc
     imu = imu or ImuParams()
-    vru = VRU(fs=1.0 / dt, err_acc={"N": imu.acc_noise, "B": imu.acc_bias_instability, "tau_cb": imu.bias_tau},
+    vru = _smsfusion().VRU(fs=1.0 / dt, err_acc={"N": imu.acc_noise, "B": imu.acc_bias_instability, "tau_cb": imu.bias_tau},
               err_gyro={"N": imu.gyro_noise, "B": imu.gyro_bias_instability, "tau_cb": imu.bias_tau})
     out = np.empty((len(acc), 2))
     for k in range(len(acc)):
@@ -85,10 +89,6 @@ def aided_ins_cog(acc: np.ndarray, gyro: np.ndarray, gnss: np.ndarray, gnss_new:
     """
     from scipy.spatial.transform import Rotation
 
-    try:
-        from smsfusion import AidedINS
-    except ImportError as exc:
-        raise ImportError("the peer comparison needs smsfusion: pip install smsfusion") from exc
     from .estimators.gnss_fusion import antenna_attitude
 
     imu, receiver = imu or ImuParams(), receiver or GnssParams()
@@ -104,7 +104,7 @@ def aided_ins_cog(acc: np.ndarray, gyro: np.ndarray, gnss: np.ndarray, gnss_new:
     x0 = np.zeros(16)
     x0[:3] = fixes[first].cog + fixes[first].rot @ arm
     x0[6:10] = Rotation.from_matrix(fixes[first].rot).as_quat(scalar_first=True)
-    ins = AidedINS(fs=1.0 / dt, x0_prior=x0, P0_prior=np.diag([1e-2] * 6 + [1e-4] * 3 + [1e-8] * 3),
+    ins = _smsfusion().AidedINS(fs=1.0 / dt, x0_prior=x0, P0_prior=np.diag([1e-2] * 6 + [1e-4] * 3 + [1e-8] * 3),
                    err_acc={"N": imu.acc_noise, "B": imu.acc_bias_instability, "tau_cb": imu.bias_tau},
                    err_gyro={"N": imu.gyro_noise, "B": imu.gyro_bias_instability, "tau_cb": imu.bias_tau},
                    lever_arm=-arm, cold_start=False)

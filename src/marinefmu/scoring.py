@@ -80,7 +80,7 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
 
     out: dict[str, dict[str, float]] = {}
     for comp in system.components:
-        kind = comp.source.replace("\\", "/").rsplit("/", 1)[-1].removesuffix(".fmu")
+        kind = comp.kind
         if f"{comp.name}.valid" not in fields or comp.name == vessel:
             continue
         m = _span(result, comp.name, settle)

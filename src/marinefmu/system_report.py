@@ -43,10 +43,6 @@ LABELS = {
 }
 
 
-def _kind(source: str) -> str:
-    return source.replace("\\", "/").rsplit("/", 1)[-1].removesuffix(".fmu")
-
-
 def _png(fig) -> str:
     import matplotlib.pyplot as plt
 
@@ -71,7 +67,7 @@ def _diagram(system: SystemDescription, plt) -> str:
         columns.setdefault(level[name], []).append(name)
     pos = {n: (3.2 * lv, -1.2 * i + 0.6 * (len(col) - 1)) for lv, col in columns.items() for i, n in enumerate(col)}
     fig, ax = plt.subplots(figsize=(10, 1.2 + 1.1 * max(len(c) for c in columns.values())))
-    kinds = {c.name: _kind(c.source) for c in system.components}
+    kinds = {c.name: c.kind for c in system.components}
     for (a, b), n in feeds.items():
         (xa, ya), (xb, yb) = pos[a], pos[b]
         ax.annotate("", xy=(xb - 1.1, yb), xytext=(xa + 1.1, ya), arrowprops={"arrowstyle": "->", "color": "0.4"})
@@ -97,7 +93,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
 
     out = []
     for comp in system.components:
-        kind, c, v = _kind(comp.source), comp.name, vessel
+        kind, c, v = comp.kind, comp.name, vessel
         if kind == "AttitudeEstimator" and f"{c}.roll" in fields:
             fig, ax = plt.subplots(2, 1, figsize=(10, 5.5))
             for a, col in (("roll", "tab:blue"), ("pitch", "tab:orange")):
@@ -197,7 +193,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
 def accuracy_rows(system: SystemDescription, scores: dict[str, dict[str, float]]) -> list[tuple[str, str, float, str, str]]:
     """(component, metric label, value, goal, status) rows of the accuracy table; status is
     ``met``, ``not met`` or empty when the issue tracker gives no goal."""
-    kinds = {c.name: _kind(c.source) for c in system.components}
+    kinds = {c.name: c.kind for c in system.components}
     rows = []
     for comp, metrics in scores.items():
         for metric, value in metrics.items():

@@ -40,7 +40,7 @@ def write_osp_system(system: SystemDescription, fmu_dir: str | Path, dest: str |
     fmu_dir = Path(fmu_dir)
     simulators, step_sizes = {}, {}
     for c in system.components:
-        src = Path(c.source) if Path(c.source).is_absolute() else fmu_dir / c.source
+        src = c.path(fmu_dir)
         if not src.is_file():
             raise SystemError_(f"component {c.name}: FMU {src} not found (run `marinefmu build`)")
         simulators[c.name] = (src, dict(c.parameters))
@@ -75,8 +75,7 @@ def run_libcosim(system: SystemDescription, fmu_dir: str | Path, work: str | Pat
     ex = CosimExecution.from_osp_config_file(str(path))
     obs = CosimObserver.create_last_value()
     ex.add_observer(obs)
-    sources = {c.name: (Path(c.source) if Path(c.source).is_absolute() else Path(fmu_dir) / c.source)
-               for c in system.components}
+    sources = {c.name: c.path(fmu_dir) for c in system.components}
     fields = []  # (field, slave index, kind, value reference)
     described = {}
     for full in record:

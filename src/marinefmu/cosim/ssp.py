@@ -54,6 +54,17 @@ class Component:
     parameters: dict[str, Value] = field(default_factory=dict)
     rate: int = 1
 
+    def path(self, base: str | Path) -> Path:
+        """The FMU file: ``source`` itself if absolute, else relative to ``base``."""
+        p = Path(self.source)
+        return p if p.is_absolute() else Path(base) / p
+
+    @property
+    def kind(self) -> str:
+        """The FMU's model name, from the source's file name (``VesselMotion`` for
+        ``fmus/VesselMotion.fmu``)."""
+        return self.source.replace("\\", "/").rsplit("/", 1)[-1].removesuffix(".fmu")
+
     def __post_init__(self) -> None:
         if not self.name or "." in self.name:
             raise ParameterError(f"component name {self.name!r} must be non-empty and contain no '.'")
@@ -260,7 +271,7 @@ def write_ssp(system: SystemDescription, fmu_dir: str | Path, dest: str | Path) 
     comps = []
     types: dict[tuple[str, str], str] = {}
     for c in system.components:
-        src = Path(c.source) if Path(c.source).is_absolute() else fmu_dir / c.source
+        src = c.path(fmu_dir)
         if not src.is_file():
             raise ParameterError(f"component {c.name}: FMU {src} not found (run `marinefmu build`)")
         files[f"resources/{src.name}"] = src

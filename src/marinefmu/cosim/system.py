@@ -116,12 +116,8 @@ class SystemRunner:
         self.base_dir = Path(base_dir)
         self.messages: list[FmuMessage] = []
         for comp in system.components:
-            if not self._source(comp.source).is_file():
-                raise SystemError_(f"component {comp.name}: FMU {self._source(comp.source)} not found (run `marinefmu build`)")
-
-    def _source(self, source: str) -> Path:
-        p = Path(source)
-        return p if p.is_absolute() else self.base_dir / p
+            if not comp.path(self.base_dir).is_file():
+                raise SystemError_(f"component {comp.name}: FMU {comp.path(self.base_dir)} not found (run `marinefmu build`)")
 
     def _callbacks(self):
         from fmpy.fmi2 import (
@@ -188,7 +184,7 @@ class SystemRunner:
         try:
             unzipped: dict[Path, Path] = {}
             for comp in sysd.components:
-                src = self._source(comp.source).resolve()
+                src = comp.path(self.base_dir).resolve()
                 if src not in unzipped:
                     unzipped[src] = Path(extract(str(src), unzipdir=str(tmp / f"{len(unzipped)}_{src.stem}")))
                 instances[comp.name] = inst = _Instance(comp.name, src, unzipped[src], callbacks)
