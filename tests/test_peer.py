@@ -3,8 +3,7 @@
 quantity). The calm / moderate / rough comparison is in ``make bench`` (part ``peer``)."""
 import pytest
 
-from marinefmu.peer import compare_attitude
-from marinefmu.sea.motion_model import VesselMotionParams, simulate_record
+from marinefmu.peer import compare_attitude, system_sea
 
 pytest.importorskip("smsfusion")
 
@@ -12,8 +11,8 @@ pytest.importorskip("smsfusion")
 def test_attitude_is_at_least_as_accurate_as_smsfusion_vru():
     """The ``system`` vessel in a moderate sea (Hs 3 m, Tp 9 s), 5 minutes, scored after 60 s:
     measured 0.053 / 0.048° (marinefmu) against 0.38 / 0.16° (VRU) roll / pitch RMS."""
-    flat = {"sea.hs": 3.0, "sea.tp": 9.0, "sea.heading": 2.6179938779914944, "imu.x": 5.0, "imu.y": 1.0, "imu.z": -3.0}
-    r = compare_attitude(simulate_record(VesselMotionParams.from_flat(flat), 300.0, 0.01), 0.01)
+    rec, _, _ = system_sea(3.0, 9.0, 300.0)
+    r = compare_attitude(rec, 0.01)
     ours, peer = r["marinefmu AttitudeEstimator"], r["smsfusion VRU"]
     for a in ("roll_deg", "pitch_deg"):
         assert ours[a] <= peer[a], r
@@ -31,10 +30,8 @@ def test_gnss_aided_cog_against_smsfusion_aided_ins():
     bounded here by 1.1 × the peer's, not by the peer's."""
     from marinefmu.peer import compare_gnss_aided
 
-    flat = {"sea.hs": 3.0, "sea.tp": 9.0, "sea.heading": 2.6179938779914944, "imu.x": 5.0, "imu.y": 1.0, "imu.z": -3.0,
-            "gnss.rate": 5.0}
-    r = compare_gnss_aided(simulate_record(VesselMotionParams.from_flat(flat), 300.0, 0.01), 0.01, (5.0, 1.0, -3.0),
-                           {"r": 4.5e-5})
+    rec, imu, fusion = system_sea(3.0, 9.0, 300.0)
+    r = compare_gnss_aided(rec, 0.01, imu, fusion)
     ours, peer = r["marinefmu GnssAccFusion"], r["smsfusion AidedINS"]
     assert ours["pos_n_cm"] <= peer["pos_n_cm"] and ours["pos_e_cm"] <= peer["pos_e_cm"], r
     assert ours["pos_d_cm"] <= 1.1 * peer["pos_d_cm"], r

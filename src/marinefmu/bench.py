@@ -202,16 +202,12 @@ def peer_comparison(duration: float = 600.0) -> dict[str, dict]:
     ``duration`` s, scored after 60 s. Roll and pitch RMS [deg]: AttitudeEstimator against VRU;
     COG RMS per axis [cm]: GnssAccFusion (r = σ_v²·Δt = 4.5e-5 for 1.5 cm at 5 Hz, as in the
     ``system`` scenario) against AidedINS told the same receiver noise."""
-    from .peer import compare_attitude, compare_gnss_aided
-    from .sea.motion_model import VesselMotionParams, simulate_record
+    from .peer import compare_attitude, compare_gnss_aided, system_sea
 
-    imu = (5.0, 1.0, -3.0)
     result = {}
     for name, (hs, tp) in PEER_SEAS.items():
-        flat = {"sea.hs": hs, "sea.tp": tp, "sea.heading": 2.6179938779914944, "vessel.preset": "polar_supply",
-                "imu.x": imu[0], "imu.y": imu[1], "imu.z": imu[2], "gnss.rate": 5.0}
-        rec = simulate_record(VesselMotionParams.from_flat(flat), duration, 0.01)
-        att, cog = compare_attitude(rec, 0.01), compare_gnss_aided(rec, 0.01, imu, {"r": 4.5e-5})
+        rec, imu, fusion = system_sea(hs, tp, duration)
+        att, cog = compare_attitude(rec, 0.01), compare_gnss_aided(rec, 0.01, imu, fusion)
         result[name] = {"hs_m": hs, "tp_s": tp, "attitude_deg": att, "cog_cm": cog}
         ours, peer = att["marinefmu AttitudeEstimator"], att["smsfusion VRU"]
         print(f"{name} (Hs {hs:g} m, Tp {tp:g} s): roll / pitch RMS marinefmu {ours['roll_deg']:.3f} / "

@@ -141,3 +141,22 @@ def compare_gnss_aided(rec: dict[str, np.ndarray], dt: float, imu_arm: tuple[flo
     k0 = int(round(settle / dt))
     return {name: {f"pos_{a}_cm": 100.0 * float(np.sqrt(np.mean((est[k0:, i] - truth[k0:, i]) ** 2)))
                    for i, a in enumerate("ned")} for name, est in runs.items()}
+
+
+def system_sea(hs: float, tp: float, duration: float, dt: float = 0.01) -> tuple[dict[str, np.ndarray], tuple, dict]:
+    """A VesselMotion record of the ``system`` scenario's vessel, IMU and GNSS in another sea.
+
+    Returns
+    -------
+    tuple
+        The record (``simulate_record``), the IMU position relative to the COG (body frame [m])
+        and the scenario's GnssAccFusion overrides (``r``) for :func:`compare_gnss_aided`.
+    """
+    from .scenarios import load_scenario
+    from .sea.motion_model import VesselMotionParams, simulate_record
+
+    system = load_scenario("system").system
+    flat = {**system.component("vessel").parameters, "sea.hs": hs, "sea.tp": tp}
+    imu = tuple(float(flat[f"imu.{a}"]) for a in "xyz")
+    fusion = {"r": system.component("fusion").parameters["r"]}
+    return simulate_record(VesselMotionParams.from_flat(flat), duration, dt), imu, fusion
