@@ -41,6 +41,8 @@ def test_nested_parameter_tables_are_flattened_to_dotted_names():
         (GOOD.replace("[scenario]", "[scenaro]"), r"unknown key\(s\) scenaro"),
         (GOOD + '[[connections]]\nfrom = "vessel.imu.acc.x"\n', r"connections\[0\] needs string keys 'from' and 'to'"),
         (GOOD + '[[connections]]\nfrom = "vessel.x"\nto = "att.u"\n', r"unknown component 'att'"),
+        (GOOD + '[[connections]]\nfrom = "vessel.x"\nto = "vessel.y"\ndelay = "yes"\n',
+         r"connections\[0\]\.delay = 'yes' must be true or false"),
         (GOOD + "[record]\nvariables = 3\n", r"record\.variables must be a list"),
         (GOOD + '[components.w]\nfmu = "X"\n[components.w.parameters]\nsea = { hs = [1, 2] }\n',
          r"components\.w\.parameters\.sea\.hs must be a number"),

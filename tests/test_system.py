@@ -103,6 +103,83 @@ def test_a_step_failure_is_reported_with_component_time_and_messages(fmu_dir, re
         SystemRunner(sysd, tmp_path).run(progress=False)
 
 
+def _relays(tmp_path, fmu_dir, relay_fmu):
+    import shutil
+
+    shutil.copy(fmu_dir / "VesselMotion.fmu", tmp_path)
+    shutil.copy(relay_fmu, tmp_path)
+    return (Component("v", "VesselMotion.fmu"), Component("a", "MfTestRelay.fmu"), Component("b", "MfTestRelay.fmu"))
+
+
+@pytest.mark.parametrize(
+    "wiring,match",
+    [
+        ([("v.truth.cog.q", "a.u")], r"v \(VesselMotion\) has no variable 'truth\.cog\.q' \(did you mean 'truth\.cog\.n', 'truth\.cog\.e', 'truth\.cog\.d'"),
+        ([("v.truth.cog.d", "a.gain")], r"a\.gain has causality 'parameter', expected input"),
+        ([("a.u", "b.u")], r"a\.u has causality 'input', expected output"),
+        ([("v.gnss.valid", "a.u")], r"connection v\.gnss\.valid -> a\.u: Boolean output cannot feed Real input"),
+        ([("v.truth.roll", "a.u")], r"connection v\.truth\.roll -> a\.u: unit 'rad' cannot feed an input in 'm'"),
+        ([("v.truth.cog.d", "a.u"), ("v.truth.cog.n", "a.u")], r"input a\.u is already fed by v\.truth\.cog\.d"),
+        ([("a.y", "b.u"), ("b.y", "a.u")], r"connection cycle without a delay: a -> b -> a"),
+    ],
+)
+def test_bad_wiring_is_refused_before_any_fmu_is_instantiated(fmu_dir, relay_fmu, tmp_path, monkeypatch, wiring, match):
+    from fmpy.fmi2 import FMU2Slave
+
+    comps = _relays(tmp_path, fmu_dir, relay_fmu)
+    sysd = SystemDescription("bad", comps, tuple(Connection.parse(a, b) for a, b in wiring), 0.01, 0.1)
+
+    def no_instantiate(*args, **kwargs):
+        raise AssertionError("an FMU was instantiated")
+
+    monkeypatch.setattr(FMU2Slave, "instantiate", no_instantiate)
+    with pytest.raises(SystemError_, match=match):
+        SystemRunner(sysd, tmp_path)
+    from marinefmu.cosim.libcosim_runner import write_osp_system
+    from marinefmu.cosim.ssp import write_ssp
+
+    with pytest.raises(SystemError_, match=match):
+        write_ssp(sysd, tmp_path, tmp_path / "bad.ssp")
+    with pytest.raises(SystemError_, match=match):
+        write_osp_system(sysd, tmp_path, tmp_path / "OspSystemStructure.xml")
+    assert not (tmp_path / "bad.ssp").exists() and not (tmp_path / "OspSystemStructure.xml").exists()
+
+
+def test_a_loop_marked_delay_runs_with_one_step_of_delay(fmu_dir, relay_fmu, tmp_path):
+    comps = _relays(tmp_path, fmu_dir, relay_fmu)
+    comps = (comps[0], Component("a", "MfTestRelay.fmu", {"gain": 1.0}), Component("b", "MfTestRelay.fmu", {"gain": 0.5}))
+    loop = (Connection.parse("a.y", "b.u"), Connection.parse("b.y", "a.u", delay=True))
+    sysd = SystemDescription("loop", comps, loop, 0.01, 0.05)
+    assert read_ssd(write_ssd(sysd, tmp_path / "SystemStructure.ssd")) == sysd   # the flag survives the SSD
+    r = SystemRunner(sysd, tmp_path).run(record=["a.y", "b.y"], progress=False)
+    # a.y(k+1) = b.y(k), b.y(k+1) = 0.5 a.y(k): from zero the loop stays at zero, exactly
+    assert np.all(r["a.y"] == 0.0) and np.all(r["b.y"] == 0.0)
+
+
+def test_a_packaged_system_naming_a_missing_variable_is_refused_on_reading(fmu_dir, relay_fmu, tmp_path):
+    import zipfile
+
+    from marinefmu.cosim.ssp import read_ssp, write_ssp
+
+    comps = _relays(tmp_path, fmu_dir, relay_fmu)
+    good = SystemDescription("s", comps[:2], (Connection.parse("v.truth.cog.d", "a.u"),), 0.01, 0.1)
+    ssp = write_ssp(good, tmp_path, tmp_path / "s.ssp")
+    with zipfile.ZipFile(ssp) as z:
+        files = {n: z.read(n) for n in z.namelist()}
+    files["SystemStructure.ssd"] = files["SystemStructure.ssd"].replace(b'endConnector="u"', b'endConnector="uu"')
+    with zipfile.ZipFile(tmp_path / "t.ssp", "w") as z:
+        for n, data in files.items():
+            z.writestr(n, data)
+    with pytest.raises(SystemError_, match=r"a \(MfTestRelay\) has no variable 'uu' \(did you mean 'u'"):
+        read_ssp(tmp_path / "t.ssp", tmp_path / "unpacked")
+    del files["resources/MfTestRelay.fmu"]
+    with zipfile.ZipFile(tmp_path / "m.ssp", "w") as z:
+        for n, data in files.items():
+            z.writestr(n, data)
+    with pytest.raises(SystemError_, match=r"component a: FMU .*MfTestRelay\.fmu not found"):
+        read_ssp(tmp_path / "m.ssp", tmp_path / "unpacked2")
+
+
 def test_build_skips_unchanged_models_and_rebuilds_a_changed_one(tmp_path):
     import shutil
     from pathlib import Path

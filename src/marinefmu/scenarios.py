@@ -18,6 +18,7 @@ Format::
     [[connections]]
     from = "vessel.imu.acc.x"
     to = "att.acc.x"
+    # delay = true          # this connection closes a feedback loop on purpose (see cosim.system_check)
 
     [record]
     variables = ["vessel.truth.cog.d"]   # optional; default every output
@@ -160,9 +161,12 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         where = f"connections[{i}]"
         if not isinstance(con, dict):
             raise ScenarioError(f"{source}: {where} must be a table with 'from' and 'to'")
-        _unknown(f"{source}: {where}", con, {"from", "to"})
+        _unknown(f"{source}: {where}", con, {"from", "to", "delay"})
+        delay = con.get("delay", False)
+        if not isinstance(delay, bool):
+            raise ScenarioError(f"{source}: {where}.delay = {delay!r} must be true or false")
         try:
-            connections.append(Connection.parse(con["from"], con["to"]))
+            connections.append(Connection.parse(con["from"], con["to"], delay))
         except (KeyError, TypeError, AttributeError):
             raise ScenarioError(f"{source}: {where} needs string keys 'from' and 'to'") from None
         except ParameterError as exc:

@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import SystemError_
 from . import osp
 from .ssp import SystemDescription
+from .system_check import check_system, lookup
 
 NS = 1_000_000_000  # libcosim time unit: ns
 
@@ -38,12 +39,10 @@ def write_osp_system(system: SystemDescription, fmu_dir: str | Path, dest: str |
         File to write.
     """
     fmu_dir = Path(fmu_dir)
+    check_system(system, fmu_dir)
     simulators, step_sizes = {}, {}
     for c in system.components:
-        src = c.path(fmu_dir)
-        if not src.is_file():
-            raise SystemError_(f"component {c.name}: FMU {src} not found (run `marinefmu build`)")
-        simulators[c.name] = (src, dict(c.parameters))
+        simulators[c.name] = (c.path(fmu_dir), dict(c.parameters))
         if c.rate != 1:
             step_sizes[c.name] = c.rate * system.step
     connections = [((k.start, k.start_var), (k.end, k.end_var)) for k in system.connections]
@@ -61,7 +60,6 @@ def run_libcosim(system: SystemDescription, fmu_dir: str | Path, work: str | Pat
         Structured array: ``time`` [s] and one field per ``component.variable`` (Real as f8,
         Boolean as bool), one row per sample from the first ``sample_every`` on.
     """
-    from fmpy import read_model_description
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
@@ -71,21 +69,21 @@ def run_libcosim(system: SystemDescription, fmu_dir: str | Path, work: str | Pat
     ratio = sample_every / system.step
     if ratio < 1 or abs(ratio - round(ratio)) > 1e-9:
         raise SystemError_(f"sample_every = {sample_every} s must be a multiple of the base step {system.step} s")
+    mds = check_system(system, fmu_dir)
+    wanted = []  # (field, component, variable)
+    for full in record:
+        comp, _, var = full.partition(".")
+        if comp not in mds:
+            raise SystemError_(f"record {full!r}: unknown component {comp!r} (known: {', '.join(mds)})")
+        v = lookup(mds[comp], comp, var)
+        if v.type not in ("Real", "Boolean"):
+            raise SystemError_(f"record {full!r}: only Real and Boolean variables can be sampled here, not {v.type}")
+        wanted.append((full, comp, v))
     path = write_osp_system(system, fmu_dir, Path(work) / "OspSystemStructure.xml")
     ex = CosimExecution.from_osp_config_file(str(path))
     obs = CosimObserver.create_last_value()
     ex.add_observer(obs)
-    sources = {c.name: c.path(fmu_dir) for c in system.components}
-    fields = []  # (field, slave index, kind, value reference)
-    described = {}
-    for full in record:
-        comp, _, var = full.partition(".")
-        if comp not in sources:
-            raise SystemError_(f"record {full!r}: unknown component {comp!r}")
-        md = described.setdefault(comp, {v.name: v for v in read_model_description(str(sources[comp])).modelVariables})
-        if var not in md or md[var].type not in ("Real", "Boolean"):
-            raise SystemError_(f"record {full!r}: no Real or Boolean variable {var!r} in {comp}")
-        fields.append((full, ex.slave_index_from_instance_name(comp), md[var].type, md[var].valueReference))
+    fields = [(full, ex.slave_index_from_instance_name(comp), v.type, v.valueReference) for full, comp, v in wanted]
     n = int(math.floor(stop_time / sample_every + 1e-9))
     out = np.zeros(n, dtype=[("time", "f8")] + [(f, "?" if k == "Boolean" else "f8") for f, _, k, _ in fields])
     for row in range(n):

@@ -74,25 +74,31 @@ class Component:
 
 @dataclass(frozen=True)
 class Connection:
-    """Output ``start.start_var`` feeds input ``end.end_var``."""
+    """Output ``start.start_var`` feeds input ``end.end_var``.
+
+    ``delay`` marks a connection that closes a feedback loop on purpose: it carries the output
+    one macro step late (as every connection does under Jacobi coupling), and a loop without
+    one such connection is refused (:mod:`marinefmu.cosim.system_check`).
+    """
 
     start: str
     start_var: str
     end: str
     end_var: str
+    delay: bool = False
 
     @classmethod
-    def parse(cls, src: str, dst: str) -> "Connection":
+    def parse(cls, src: str, dst: str, delay: bool = False) -> "Connection":
         """From ``"vessel.imu.acc.x"``, ``"att.acc.x"`` (component name before the first dot)."""
         for s in (src, dst):
             if "." not in s:
                 raise ParameterError(f"connection end {s!r} must be '<component>.<variable>'")
         a, av = src.split(".", 1)
         b, bv = dst.split(".", 1)
-        return cls(a, av, b, bv)
+        return cls(a, av, b, bv, delay)
 
     def __str__(self) -> str:
-        return f"{self.start}.{self.start_var} -> {self.end}.{self.end_var}"
+        return f"{self.start}.{self.start_var} -> {self.end}.{self.end_var}{' (delay)' if self.delay else ''}"
 
 
 @dataclass(frozen=True)
@@ -186,8 +192,11 @@ def write_ssd(system: SystemDescription, path: str | Path, types: Mapping[tuple[
         ET.SubElement(ann, _q("mf", "Rate"), {"multiplier": str(comp.rate)})
     cons = ET.SubElement(sys_el, _q("ssd", "Connections"))
     for con in system.connections:
-        ET.SubElement(cons, _q("ssd", "Connection"), {"startElement": con.start, "startConnector": con.start_var,
-                                                      "endElement": con.end, "endConnector": con.end_var})
+        ce = ET.SubElement(cons, _q("ssd", "Connection"), {"startElement": con.start, "startConnector": con.start_var,
+                                                           "endElement": con.end, "endConnector": con.end_var})
+        if con.delay:
+            ann = ET.SubElement(ET.SubElement(ce, _q("ssd", "Annotations")), _q("ssc", "Annotation"), {"type": ANNOTATION})
+            ET.SubElement(ann, _q("mf", "Delay"), {"steps": "1"})
     exp = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
                         {"startTime": repr(system.start_time), "stopTime": repr(system.stop_time)})
     ann = ET.SubElement(ET.SubElement(exp, _q("ssd", "Annotations")), _q("ssc", "Annotation"), {"type": ANNOTATION})
@@ -241,7 +250,8 @@ def read_ssd(path: str | Path) -> SystemDescription:
         rate_el = ce.find(f"ssd:Annotations/ssc:Annotation[@type='{ANNOTATION}']/mf:Rate", NS)
         components.append(Component(name, ce.get("source"), params, int(rate_el.get("multiplier")) if rate_el is not None else 1))
     connections = tuple(
-        Connection(c.get("startElement"), c.get("startConnector"), c.get("endElement"), c.get("endConnector"))
+        Connection(c.get("startElement"), c.get("startConnector"), c.get("endElement"), c.get("endConnector"),
+                   c.find(f"ssd:Annotations/ssc:Annotation[@type='{ANNOTATION}']/mf:Delay", NS) is not None)
         for c in sys_el.findall("ssd:Connections/ssd:Connection", NS)
     )
     exp = root.find("ssd:DefaultExperiment", NS)
@@ -264,23 +274,19 @@ def write_ssp(system: SystemDescription, fmu_dir: str | Path, dest: str | Path) 
     import tempfile
     import zipfile
 
-    from fmpy import read_model_description
+    from .system_check import check_system
 
     fmu_dir, dest = Path(fmu_dir), Path(dest)
+    mds = check_system(system, fmu_dir)
     files: dict[str, Path] = {}
     comps = []
-    types: dict[tuple[str, str], str] = {}
     for c in system.components:
         src = c.path(fmu_dir)
-        if not src.is_file():
-            raise ParameterError(f"component {c.name}: FMU {src} not found (run `marinefmu build`)")
         files[f"resources/{src.name}"] = src
         comps.append(Component(c.name, f"resources/{src.name}", c.parameters, c.rate))
-        variables = {v.name: v.type for v in read_model_description(str(src)).modelVariables}
-        for con in system.connections:
-            for name, var in ((con.start, con.start_var), (con.end, con.end_var)):
-                if name == c.name and var in variables:
-                    types[(name, var)] = variables[var]
+    variables = {c: {v.name: v.type for v in md.modelVariables} for c, md in mds.items()}
+    types = {(name, var): variables[name][var] for con in system.connections
+             for name, var in ((con.start, con.start_var), (con.end, con.end_var))}
     packaged = SystemDescription(system.name, tuple(comps), system.connections, system.step, system.stop_time,
                                  system.start_time)
     dest.parent.mkdir(parents=True, exist_ok=True)
@@ -295,7 +301,9 @@ def write_ssp(system: SystemDescription, fmu_dir: str | Path, dest: str | Path) 
 
 def read_ssp(path: str | Path, into: str | Path) -> SystemDescription:
     """Unpack an ``.ssp`` into the folder ``into`` and read its ``SystemStructure.ssd``; the
-    component sources are returned as absolute paths into that folder."""
+    component sources are returned as absolute paths into that folder. The system is checked
+    against its FMUs (:func:`~marinefmu.cosim.system_check.check_system`) before it is returned,
+    so a package naming a missing FMU or variable is refused before anything is instantiated."""
     import zipfile
 
     path, into = Path(path), Path(into)
@@ -304,6 +312,10 @@ def read_ssp(path: str | Path, into: str | Path) -> SystemDescription:
             z.extractall(into)
     except (OSError, zipfile.BadZipFile) as exc:
         raise ParameterError(f"{path}: not a readable SSP package: {exc}") from exc
+    from .system_check import check_system
+
     system = read_ssd(into / "SystemStructure.ssd")
     comps = tuple(Component(c.name, str((into / c.source).resolve()), c.parameters, c.rate) for c in system.components)
-    return SystemDescription(system.name, comps, system.connections, system.step, system.stop_time, system.start_time)
+    system = SystemDescription(system.name, comps, system.connections, system.step, system.stop_time, system.start_time)
+    check_system(system, into)
+    return system

@@ -13,7 +13,6 @@ messages, and every instance is freed whatever happens.
 """
 from __future__ import annotations
 
-import difflib
 import logging
 import math
 import shutil
@@ -28,6 +27,7 @@ import numpy as np
 
 from ..errors import SystemError_
 from .ssp import SystemDescription
+from .system_check import check_system, lookup
 
 log = logging.getLogger("marinefmu.fmu")
 STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
@@ -46,13 +46,11 @@ class FmuMessage:
 class _Instance:
     """One instantiated component: FMU2Slave plus name → (type, value reference) lookup."""
 
-    def __init__(self, name: str, fmu_path: Path, unzip_dir: Path, callbacks: Any) -> None:
-        from fmpy import read_model_description
+    def __init__(self, name: str, md: Any, unzip_dir: Path, callbacks: Any) -> None:
         from fmpy.fmi2 import FMU2Slave
 
         self.name = name
-        self.md = read_model_description(str(fmu_path))
-        self.vars = {v.name: v for v in self.md.modelVariables}
+        self.md = md
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=str(unzip_dir),
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
         self.fmu.instantiate(loggingOn=True, callbacks=callbacks)
@@ -60,38 +58,14 @@ class _Instance:
         self.fmu.setDebugLogging(True, [])
 
     def variable(self, var: str, causality: Sequence[str] | None = None):
-        v = self.vars.get(var)
-        if v is None:
-            close = difflib.get_close_matches(var, self.vars, n=3)
-            hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
-            raise SystemError_(f"{self.name} ({self.md.modelName}) has no variable {var!r}{hint}")
-        if causality is not None and v.causality not in causality:
-            raise SystemError_(f"{self.name}.{var} has causality {v.causality!r}, expected {' or '.join(causality)}")
-        return v
+        return lookup(self.md, self.name, var, None if causality is None else tuple(causality))
 
     def set_value(self, var: str, value: Any) -> None:
+        """Set a parameter (already type-checked by :func:`check_system`)."""
         v = self.variable(var, ("parameter", "input"))
-        vr = [v.valueReference]
-        kind = v.type
-        try:
-            if kind == "Real":
-                if isinstance(value, (bool, str)):
-                    raise TypeError
-                self.fmu.setReal(vr, [float(value)])
-            elif kind in ("Integer", "Enumeration"):
-                if isinstance(value, bool) or not float(value).is_integer():
-                    raise TypeError
-                self.fmu.setInteger(vr, [int(value)])
-            elif kind == "Boolean":
-                if not isinstance(value, bool):
-                    raise TypeError
-                self.fmu.setBoolean(vr, [value])
-            else:
-                if not isinstance(value, str):
-                    raise TypeError
-                self.fmu.setString(vr, [value])
-        except (TypeError, ValueError):
-            raise SystemError_(f"{self.name}.{var} is {kind}; cannot set it to {value!r}") from None
+        kind = "Integer" if v.type == "Enumeration" else v.type
+        cast = {"Real": float, "Integer": int, "Boolean": bool}.get(kind, str)
+        _accessor(self.fmu, "set", kind)([v.valueReference], [cast(value)])
 
 
 class SystemRunner:
@@ -115,9 +89,7 @@ class SystemRunner:
         self.system = system
         self.base_dir = Path(base_dir)
         self.messages: list[FmuMessage] = []
-        for comp in system.components:
-            if not comp.path(self.base_dir).is_file():
-                raise SystemError_(f"component {comp.name}: FMU {comp.path(self.base_dir)} not found (run `marinefmu build`)")
+        self.descriptions = check_system(system, self.base_dir)
 
     def _callbacks(self):
         from fmpy.fmi2 import (
@@ -177,6 +149,7 @@ class SystemRunner:
         n_steps = int(math.floor((stop - t0) / sysd.step + 1e-9))
         if n_steps < 1:
             raise SystemError_(f"stop time {stop} s leaves no step of {sysd.step} s after start {t0} s")
+        fields = self._record_fields(self.descriptions, record)  # refused before anything is instantiated
         callbacks = self._callbacks()
         tmp = Path(tempfile.mkdtemp(prefix="marinefmu_"))
         instances: dict[str, _Instance] = {}
@@ -187,20 +160,17 @@ class SystemRunner:
                 src = comp.path(self.base_dir).resolve()
                 if src not in unzipped:
                     unzipped[src] = Path(extract(str(src), unzipdir=str(tmp / f"{len(unzipped)}_{src.stem}")))
-                instances[comp.name] = inst = _Instance(comp.name, src, unzipped[src], callbacks)
+                instances[comp.name] = inst = _Instance(comp.name, self.descriptions[comp.name], unzipped[src], callbacks)
                 inst.fmu.setupExperiment(startTime=t0)
                 for name, value in comp.parameters.items():
                     inst.set_value(name, value)
-            # wiring, checked before anything steps
+            # wiring (checked by check_system before anything was instantiated)
             wires = []  # (end component, getter, source vr, setter, destination vr), resolved once
             for con in sysd.connections:
-                a = instances[con.start].variable(con.start_var, ("output",))
-                b = instances[con.end].variable(con.end_var, ("input",))
-                if a.type != b.type:
-                    raise SystemError_(f"connection {con}: {a.type} output cannot feed {b.type} input")
+                a = instances[con.start].variable(con.start_var)
+                b = instances[con.end].variable(con.end_var)
                 wires.append((con.end, _accessor(instances[con.start].fmu, "get", a.type), [a.valueReference],
                               _accessor(instances[con.end].fmu, "set", b.type), [b.valueReference]))
-            fields = self._record_fields(instances, record)
             for name, inst in instances.items():
                 logged = len(self.messages)
                 try:
@@ -246,19 +216,19 @@ class SystemRunner:
             shutil.rmtree(tmp, ignore_errors=True)
 
     @staticmethod
-    def _record_fields(instances: dict[str, _Instance], record: Sequence[str] | None) -> dict[str, tuple[str, str, int]]:
+    def _record_fields(mds: dict[str, Any], record: Sequence[str] | None) -> dict[str, tuple[str, str, int]]:
         fields: dict[str, tuple[str, str, int]] = {}
         if record is None:
-            for name, inst in instances.items():
-                for v in inst.md.modelVariables:
+            for name, md in mds.items():
+                for v in md.modelVariables:
                     if v.causality == "output" and v.type in ("Real", "Boolean"):
                         fields[f"{name}.{v.name}"] = (name, v.type, v.valueReference)
             return fields
         for full in record:
             comp, _, var = full.partition(".")
-            if comp not in instances:
-                raise SystemError_(f"record {full!r}: unknown component {comp!r} (known: {', '.join(instances)})")
-            v = instances[comp].variable(var)
+            if comp not in mds:
+                raise SystemError_(f"record {full!r}: unknown component {comp!r} (known: {', '.join(mds)})")
+            v = lookup(mds[comp], comp, var)
             if v.type not in ("Real", "Boolean", "Integer"):
                 raise SystemError_(f"record {full!r}: only Real, Integer and Boolean variables can be recorded")
             fields[full] = (comp, v.type, v.valueReference)
