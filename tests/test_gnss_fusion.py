@@ -260,3 +260,27 @@ def test_bounding_sample_means_keep_a_perfect_coast_exact():
                  gnss_valid=rec["gnss_valid"])
         err[mode] = np.max(np.linalg.norm(r["pos"][gap] - rec["cog"][gap], axis=1))
     assert err["mean"] < 0.005 and err["latest"] > 0.10, err
+
+
+def test_q_down_sets_the_down_axis_process_noise_only():
+    dt = 0.1
+    q = process_noise(dt, 0.005, None, q_down=1e-6)
+    base = process_noise(dt, 0.005, None)
+    for i in (0, 1, 3, 4):
+        assert q[i, i] == base[i, i]
+    assert q[2, 2] == pytest.approx(1e-6 * dt ** 3 / 3) and q[5, 5] == pytest.approx(1e-6 * dt)
+    assert q[2, 5] == pytest.approx(1e-6 * dt ** 2 / 2)
+    with pytest.raises(ParameterError, match=r"q_down = -1\.0 is out of range"):
+        FusionParams(q_down=-1.0)
+
+
+def test_one_receiver_fusion_returns_the_fix_of_a_still_point():
+    """fuse_receiver: the four-antenna filter on one receiver (virtual rigid antenna set)."""
+    from marinefmu.estimators.gnss_fusion import fuse_receiver
+
+    n, dt = 500, 0.1
+    f_n = np.tile([0.0, 0.0, -9.80665], (n, 1))
+    pos = np.tile([3.0, -2.0, 0.5], (n, 1))
+    out = fuse_receiver(f_n, dt, pos, np.arange(n) % 10 == 0)
+    np.testing.assert_allclose(out["pos"][-1], [3.0, -2.0, 0.5], atol=1e-9)
+    assert out["valid"][-1]

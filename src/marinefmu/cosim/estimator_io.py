@@ -102,6 +102,7 @@ FUSION_PARAMETERS: list[Variable] = [
     *[v for i, arm in enumerate(_FU.antennas) for v in vec(f"ant{i + 1}", "xyz", arm, "m", f"GNSS antenna {i + 1} lever arm relative to the COG, body frame")],
     *vec("acc_lever_arm", "xyz", 0.0, "m", "Accelerometer position relative to the COG, body frame"),
     real("q", _FU.q, "m2/s3", "Acceleration process-noise density (paper 001 eq. 16), > 0"),
+    real("q_down", 0.0, "m2/s3", "Process-noise density of the down axis, > 0; 0 = the same as q (the paper)"),
     real("r", _FU.r, "m2*s", "GNSS position noise, R = r/dt (paper 001 eq. 17), > 0"),
     Variable("attitude_correction", "boolean", True, "", "Rotate the specific force with the attitude (false: the paper's uncorrected case)"),
     Variable("propagation", "string", _FU.propagation, "", f"Attitude between GNSS epochs: one of {', '.join(PROPAGATION_CHOICES)} (gyro needs gyro.* inputs)"),
@@ -147,7 +148,7 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
     xyz = lambda prefix: tuple(v[f"{prefix}.{a}"] for a in "xyz")  # noqa: E731
     return FusionParams(
         antennas=tuple(xyz(f"ant{i + 1}") for i in range(ANTENNAS)), acc_lever_arm=xyz("acc_lever_arm"),
-        q=v["q"], r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
+        q=v["q"], q_down=v["q_down"] or None, r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
         coast=v["coast"], coast_sigma=v["coast_sigma"], coast_window=v["coast_window"],

@@ -104,6 +104,11 @@ class FusionParams:
         Accelerometer position relative to the COG, body frame [m]. [``acc_lever_arm.*``]
     q : float
         Acceleration process-noise density of eq. 16 [m²/s³], > 0. [``q``]
+    q_down : float or None
+        Process-noise density of the down axis [m²/s³], > 0; None (FMU: 0) = ``q`` as the
+        paper. Beyond the paper: an attitude error ε puts g·ε into the horizontal a_n but only
+        g·ε²/2 (plus the horizontal specific force times ε) into the vertical one, so the down
+        axis can trust the accelerometer more. [``q_down``]
     r : float
         GNSS position noise of eq. 17, R = r/Δt [m²·s], > 0. The defaults q = 0.005,
         r = 1e-5 (at Δt = 0.01 s, R = (3 cm)²) were the best of a 3 × 3 grid on experiment (b)
@@ -149,6 +154,7 @@ class FusionParams:
     antennas: tuple = DEFAULT_ANTENNAS
     acc_lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
     q: float = 0.005
+    q_down: float | None = None
     r: float = 1e-5
     attitude_correction: bool = True
     propagation: str = "gyro"
@@ -178,6 +184,8 @@ class FusionParams:
         object.__setattr__(self, "arms", arms)
         check_vector("acc_lever_arm", self.acc_lever_arm, unit="m")
         check_range("q", self.q, lo=0.0, lo_open=True, hi=1e6, unit="m2/s3")
+        if self.q_down is not None:
+            check_range("q_down", self.q_down, lo=0.0, lo_open=True, hi=1e6, unit="m2/s3")
         check_range("r", self.r, lo=0.0, lo_open=True, hi=1e6, unit="m2*s")
         check_choice("propagation", self.propagation, PROPAGATION_CHOICES)
         check_choice("step_input", self.step_input, STEP_INPUT_CHOICES)
@@ -295,10 +303,12 @@ def transition(dt: float, bias: bool) -> tuple[np.ndarray, np.ndarray]:
     return f, np.vstack((g, 0 * i3))
 
 
-def process_noise(dt: float, q: float, bias_rw: float | None) -> np.ndarray:
-    """Q of eq. 16 for the 3 axes, plus bias_rw²·Δt on the bias states if given."""
+def process_noise(dt: float, q: float, bias_rw: float | None, q_down: float | None = None) -> np.ndarray:
+    """Q of eq. 16 for the 3 axes (``q_down`` on the down axis if given, else ``q``), plus
+    bias_rw²·Δt on the bias states if given."""
     i3 = np.eye(3)
-    qq = q * np.block([[dt ** 3 / 3 * i3, dt ** 2 / 2 * i3], [dt ** 2 / 2 * i3, dt * i3]])
+    qd = np.diag([q, q, q if q_down is None else q_down])
+    qq = np.block([[dt ** 3 / 3 * qd, dt ** 2 / 2 * qd], [dt ** 2 / 2 * qd, dt * qd]])
     if bias_rw is None:
         return qq
     out = np.zeros((9, 9))
@@ -395,7 +405,7 @@ class GnssAccFusion:
         if self.initialised:
             if dt != self._model_dt:  # rebuilt only when the step size changes
                 self.kf.F, self.kf.B = transition(dt, p.bias_states)
-                self.kf.Q = process_noise(dt, p.q, p.bias_rw if p.bias_states else None)
+                self.kf.Q = process_noise(dt, p.q, p.bias_rw if p.bias_states else None, p.q_down)
                 self._model_dt = dt
             self.kf.predict(u=u.reshape(3, 1))
             self.prior = (self.kf.x.copy(), self.kf.P.copy())
@@ -601,6 +611,48 @@ def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyr
         out["pos_smooth"] = sx[:, :3] + arms
         out["vel_smooth"] = sx[:, 3:6] + (out["vel"] - xs[:, 3:6])
     return out
+
+
+def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarray,
+                  params: FusionParams | None = None) -> dict[str, np.ndarray]:
+    """The fusion filter on one GNSS receiver, with the attitude applied by the caller.
+
+    For a data set with a single antenna (and a compass) instead of four: ``f_n`` is the
+    specific force already rotated into NED by an external attitude (eqs. 25-26 done
+    outside: f_n = R_nb f_b), ``pos`` the receiver's fixes of the accelerometer point.
+    :class:`GnssAccFusion` runs with ``attitude_correction=False`` (a_n = f_n + g_n),
+    ``propagation="hold"`` and no lever arm, and each fix is handed to it as a rigid antenna
+    set at identity attitude around the fix (the antenna solution then returns exactly the
+    fix), so the Kalman filter, gating, bias states, coasting and re-initialisation are the
+    same code as the four-antenna estimator's.
+
+    Parameters
+    ----------
+    f_n : numpy.ndarray
+        (N, 3) specific force in NED [m/s²] at t_k = (k + 1)·dt.
+    dt : float
+        Sample interval [s].
+    pos : numpy.ndarray
+        (N, 3) receiver position of the accelerometer point, NED [m], read where ``pos_new``.
+    pos_new : numpy.ndarray
+        (N,) bool, True where a new fix arrived.
+    params : FusionParams, optional
+        ``q``, ``q_down``, ``r``, ``gate``, ``bias_states`` … (its antennas, lever arm,
+        attitude correction and propagation are overridden as above).
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        As :func:`fuse`.
+    """
+    from dataclasses import replace
+
+    p = replace(params or FusionParams(), attitude_correction=False, propagation="hold", acc_lever_arm=(0.0, 0.0, 0.0))
+    pos = np.asarray(pos, dtype=float)
+    if pos.ndim != 2 or pos.shape[1] != 3:
+        raise ShapeError(f"expected pos (N, 3); got {pos.shape}")
+    virtual = np.hstack([pos + arm for arm in p.arms])
+    return fuse(f_n, dt, virtual, pos_new, None, p)
 
 
 def rts_smooth(xs: np.ndarray, ps: np.ndarray, priors: list, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
