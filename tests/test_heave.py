@@ -71,16 +71,21 @@ def test_fixed_lag_smoother_equals_rts_on_data_up_to_now():
     ys = rng.normal(size=300)
     lag = 25
     sm = FixedLagOutputs(lag, m.n)
+    sm.set_model(np.eye(m.n), m.P, m.closed_loop, m.C, m.S)
     xp, smoothed = np.zeros(m.n), {}
+    coast: set[int] = set()
     for k, y in enumerate(ys):
-        sm.push(np.eye(m.n), xp, m.P)
-        innovation = y - m.C @ xp
-        post = xp + m.K * innovation
-        sm.correct(m.C, innovation, m.S)
+        sm.push(xp)
+        if k in coast:
+            post = xp
+        else:
+            innovation = y - m.C @ xp
+            post = xp + m.K * innovation
+            sm.correct(innovation)
         popped = sm.pop()
         if popped is not None:
             smoothed[k - lag] = popped[0]
-        sm.propagate(m.closed_loop)
+        sm.propagate(m.A if k in coast else None)
         xp = m.A @ post
     for k in (150, 299):
         kf = KalmanFilter(dim_x=m.n, dim_z=1)      # batch_filter moves the filter: a fresh one each time
@@ -90,6 +95,39 @@ def test_fixed_lag_smoother_equals_rts_on_data_up_to_now():
         xs, ps, _, _ = kf.batch_filter(ys[:k + 1, None])
         xs_s, _, _, _ = rts_smoother(xs, ps, [m.A] * (k + 1), [m.Q] * (k + 1))
         np.testing.assert_allclose(smoothed[k - lag], xs_s[k - lag, :, 0], atol=1e-9)
+
+
+def test_fixed_lag_table_equals_explicit_propagation_through_coasted_steps():
+    """The tabulated steady-state path and its switch to explicit rows at a coasted step (and
+    back lag + 1 steps later) give what propagating every row block explicitly gives."""
+    rng = np.random.default_rng(5)
+    m = build_bank(np.array([0.6, 1.0]), 0.1, 1e-2, 1e-3, 1e-2, "exact", "paper")
+    lag, coast = 25, {60, 61, 62, 100, 200}
+    sm = FixedLagOutputs(lag, 2)
+    sm.set_model(m.heave_rows, m.P, m.closed_loop, m.C, m.S)
+    rows, est, xp = [], [], np.zeros(m.n)        # the reference: explicit W and estimates per pending time
+    got, want = [], []
+    for k, y in enumerate(rng.normal(size=300)):
+        sm.push(xp)
+        rows.append(m.heave_rows @ m.P)
+        est.append(m.heave_rows @ xp)
+        post = xp
+        if k not in coast:
+            innovation = y - m.C @ xp
+            post = xp + m.K * innovation
+            sm.correct(innovation)
+            est = [e + (w @ m.C) * innovation / m.S for e, w in zip(est, rows)]
+        popped = sm.pop()
+        if len(est) > lag:
+            want.append(est.pop(0))
+            rows.pop(0)
+            got.append(popped[0])
+        phi = m.A if k in coast else m.closed_loop
+        sm.propagate(m.A if k in coast else None)
+        rows = [w @ phi.T for w in rows]
+        xp = m.A @ post
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-14)
+    assert sm.rows is None   # back on the table
 
 
 def test_carry_map_keeps_heave_heave_rate_and_offset():
@@ -196,7 +234,8 @@ def test_heave_response_is_what_the_observer_does_to_a_sinusoid(model, measureme
     for w in (0.35, 0.55, 0.9):
         obs = HeaveObserver(HeaveObserverParams(model=model, measurement=measurement, smoother_lag=0.0))
         obs._start(dt)
-        obs.model, obs.xp, obs.x = m, np.zeros(m.n), np.zeros(m.n)
+        obs._use(m)
+        obs.xp, obs.x = np.zeros(m.n), np.zeros(m.n)
         t = np.arange(20000) * dt
         est = []
         for k, a in enumerate(-w**2 * np.cos(w * t)):

@@ -1,23 +1,36 @@
-"""Fixed-step co-simulation master on FMPy's ``FMU2Slave``.
+"""Fixed-step co-simulation master: FMUs through FMPy, or the same slaves in-process.
 
 The master instantiates every component, applies its parameters, and steps on a base step h:
 at base step k (t = t0 + k·h) every component with rate multiplier m and k mod m = 0 first
 receives its inputs from the outputs all components held at t, then all of them step by m·h
 (Jacobi coupling, as OSP libcosim's fixed-step algorithm does). Chosen variables are recorded
-at every base step into a structured numpy array whose fields are ``component.variable``.
+at every base step into a structured numpy array whose fields are ``component.variable``, in
+memory or streamed to a ``.npy`` file in chunks (``out_file``) for long runs.
+
+Two engines run the same system the same way:
+
+- ``engine="fmpy"`` (default): every FMU through FMPy's ``FMU2Slave`` (the FMI 2.0 C API).
+- ``engine="python"``: the slave class of each FMU (the pythonfmu script in its
+  ``resources/``) instantiated directly in this interpreter and called without FMI: no
+  ctypes, no C++ loader. Same code, same results (bit for bit, tested); the bench compares the
+  two to measure what FMI costs.
 
 FMU logging is switched on and every message is collected (:attr:`SystemRunner.messages`) and
 forwarded to the Python logger ``marinefmu.fmu``; a failing FMI call raises
 :class:`~marinefmu.errors.SystemError_` naming the component, the time and its last
-messages, and every instance is freed whatever happens.
+messages, and every instance is freed whatever happens. The system is checked against the
+FMUs' model descriptions before anything is instantiated
+(:func:`~marinefmu.cosim.system_check.check_system`).
 """
 from __future__ import annotations
 
+import importlib.util
+import itertools
 import logging
 import math
 import shutil
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from ctypes import byref
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +44,9 @@ from .system_check import check_system, lookup
 
 log = logging.getLogger("marinefmu.fmu")
 STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
+ENGINES = ("fmpy", "python")
+#: Rows of a result kept in memory before they are written out (``out_file``).
+CHUNK_ROWS = 8192
 
 
 @dataclass(frozen=True)
@@ -43,33 +59,146 @@ class FmuMessage:
     text: str
 
 
-class _Instance:
-    """One instantiated component: FMU2Slave plus name → (type, value reference) lookup."""
+def _fmi_type(kind: str) -> str:
+    return "Integer" if kind == "Enumeration" else kind
 
-    def __init__(self, name: str, md: Any, unzip_dir: Path, callbacks: Any) -> None:
+
+class _FmpyComponent:
+    """One component as an FMU through FMPy's ``FMU2Slave``; messages arrive by callback."""
+
+    def __init__(self, name: str, md: Any, unzip_dir: Path, callbacks: Any, messages: list[FmuMessage]) -> None:
         from fmpy.fmi2 import FMU2Slave
 
-        self.name = name
-        self.md = md
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=str(unzip_dir),
-                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+        self.name, self.md = name, md
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=str(unzip_dir),
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
         self.fmu.instantiate(loggingOn=True, callbacks=callbacks)
-        self.instantiated = True
         self.fmu.setDebugLogging(True, [])
 
-    def variable(self, var: str, causality: Sequence[str] | None = None):
-        return lookup(self.md, self.name, var, None if causality is None else tuple(causality))
+    def accessor(self, op: str, kind: str) -> Callable:
+        """``getReal``/``setBoolean``/… of the FMU for a variable type."""
+        return getattr(self.fmu, f"{op}{_fmi_type(kind)}")
 
-    def set_value(self, var: str, value: Any) -> None:
-        """Set a parameter (already type-checked by :func:`check_system`)."""
-        v = self.variable(var, ("parameter", "input"))
-        kind = "Integer" if v.type == "Enumeration" else v.type
-        cast = {"Real": float, "Integer": int, "Boolean": bool}.get(kind, str)
-        _accessor(self.fmu, "set", kind)([v.valueReference], [cast(value)])
+    def setup(self, t0: float) -> None:
+        self.fmu.setupExperiment(startTime=t0)
+
+    def initialise(self) -> None:
+        self.fmu.enterInitializationMode()
+        self.fmu.exitInitializationMode()
+
+    def do_step(self, t: float, h: float) -> None:
+        self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+
+    def terminate(self) -> None:
+        self.fmu.terminate()
+
+    def free(self) -> None:
+        self.fmu.freeInstance()
+
+
+class _PythonComponent:
+    """One component as its pythonfmu slave class, run in this interpreter without FMI.
+
+    The slave script is the one packed in the FMU (``resources/<model>.py``), imported under a
+    module name unique to the instance; its messages are taken from the slave's log queue after
+    every call, as pythonfmu's C++ side does."""
+
+    _count = itertools.count()
+
+    def __init__(self, name: str, md: Any, unzip_dir: Path, messages: list[FmuMessage]) -> None:
+        self.name, self.md, self.messages = name, md, messages
+        model = md.coSimulation.modelIdentifier
+        resources = Path(unzip_dir) / "resources"
+        spec = importlib.util.spec_from_file_location(f"_marinefmu_in_process_{model}_{next(self._count)}",
+                                                      resources / f"{model}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        self.slave = getattr(module, model)(instance_name=name, resources=str(resources), visible=False)
+
+    def _drain(self) -> None:
+        queue = self.slave.log_queue
+        for m in queue:
+            msg = FmuMessage(self.name, m.status.name.upper(), m.category or "", m.msg)
+            self.messages.append(msg)
+            level = logging.ERROR if msg.status in ("ERROR", "FATAL") else logging.WARNING if msg.status == "WARNING" else logging.DEBUG
+            log.log(level, "[%s] %s: %s", msg.status, msg.instance, msg.text)
+        queue.clear()
+
+    def accessor(self, op: str, kind: str) -> Callable:
+        """``get_real``/``set_boolean``/… of the slave for a variable type."""
+        return getattr(self.slave, f"{op}_{_fmi_type(kind).lower()}")
+
+    def setup(self, t0: float) -> None:
+        self.slave.setup_experiment(t0, None, None)
+
+    def initialise(self) -> None:
+        self.slave.enter_initialization_mode()
+        self.slave.exit_initialization_mode()
+        self._drain()
+
+    def do_step(self, t: float, h: float) -> None:
+        ok = self.slave.do_step(t, h)
+        if self.slave.log_queue:
+            self._drain()
+        if not ok:
+            raise RuntimeError("doStep returned fmi2Discard")
+
+    def terminate(self) -> None:
+        self.slave.terminate()
+        self._drain()
+
+    def free(self) -> None:
+        self.slave = None
+
+
+class _Recorder:
+    """Rows of a result: a structured array in memory, or a ``.npy`` file written in chunks of
+    :data:`CHUNK_ROWS` rows (memory stays flat however long the run)."""
+
+    def __init__(self, dtype: np.dtype, rows: int, out_file: str | Path | None) -> None:
+        self.dtype, self.rows = dtype, rows
+        self.path = None if out_file is None else Path(out_file)
+        if self.path is None:
+            self.out = np.zeros(rows, dtype=dtype)
+            self.buf = self.out
+        else:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.fh = open(self.path, "wb")
+            np.lib.format.write_array_header_1_0(self.fh, {"descr": np.lib.format.dtype_to_descr(dtype),
+                                                           "fortran_order": False, "shape": (rows,)})
+            self.buf = np.zeros(min(rows, CHUNK_ROWS), dtype=dtype)
+        self.filled = 0   # rows of buf in use (file mode)
+        self.written = 0  # rows already on disk
+
+    def row(self, i: int) -> np.void:
+        """The row ``i`` to fill (rows come in order)."""
+        if self.path is None:
+            return self.buf[i]
+        if self.filled == len(self.buf):
+            self._flush()
+        self.filled += 1
+        return self.buf[self.filled - 1]
+
+    def _flush(self) -> None:
+        self.fh.write(self.buf[:self.filled].tobytes())
+        self.written += self.filled
+        self.filled = 0
+
+    def finish(self) -> np.ndarray:
+        """The result: the array, or the file opened read-only as a memory map."""
+        if self.path is None:
+            return self.out
+        self._flush()
+        self.fh.close()
+        return np.load(self.path, mmap_mode="r")
+
+    def close(self) -> None:
+        if self.path is not None and not self.fh.closed:
+            self.fh.close()
 
 
 class SystemRunner:
-    """Run a :class:`~marinefmu.cosim.ssp.SystemDescription` with FMPy.
+    """Run a :class:`~marinefmu.cosim.ssp.SystemDescription` with FMPy or in-process.
 
     Parameters
     ----------
@@ -77,6 +206,9 @@ class SystemRunner:
         Components, connections, base step.
     base_dir : str or Path
         Folder that relative component sources are resolved against.
+    engine : {"fmpy", "python"}
+        FMUs through FMI with FMPy, or their slave classes in this interpreter (module
+        docstring).
 
     Examples
     --------
@@ -85,9 +217,12 @@ class SystemRunner:
     >>> result["vessel.truth.cog.d"]                                # doctest: +SKIP
     """
 
-    def __init__(self, system: SystemDescription, base_dir: str | Path = ".") -> None:
+    def __init__(self, system: SystemDescription, base_dir: str | Path = ".", engine: str = "fmpy") -> None:
+        if engine not in ENGINES:
+            raise SystemError_(f"engine = {engine!r} is not allowed: must be one of {', '.join(map(repr, ENGINES))}")
         self.system = system
         self.base_dir = Path(base_dir)
+        self.engine = engine
         self.messages: list[FmuMessage] = []
         self.descriptions = check_system(system, self.base_dir)
 
@@ -121,8 +256,14 @@ class SystemRunner:
         details = "".join(f"\n  [{m.status}] {m.text}" for m in recent)
         return SystemError_(f"{inst}: {what} failed at t = {t:.6g} s: {exc}{details}")
 
+    def _instantiate(self, comp: Any, unzip_dir: Path, callbacks: Any):
+        md = self.descriptions[comp.name]
+        if self.engine == "python":
+            return _PythonComponent(comp.name, md, unzip_dir, self.messages)
+        return _FmpyComponent(comp.name, md, unzip_dir, callbacks, self.messages)
+
     def run(self, stop_time: float | None = None, record: Sequence[str] | None = None,
-            progress: bool | None = None) -> np.ndarray:
+            progress: bool | None = None, out_file: str | Path | None = None) -> np.ndarray:
         """Simulate from the system's start time to ``stop_time`` [s].
 
         Parameters
@@ -133,6 +274,10 @@ class SystemRunner:
             ``component.variable`` names to record; default every real and boolean output.
         progress : bool, optional
             Show a progress bar (default: when the run has more than 2,000 base steps).
+        out_file : str or Path, optional
+            Stream the rows to this ``.npy`` file as the run goes (:data:`CHUNK_ROWS` at a
+            time) instead of keeping them in memory; the result is then the file opened as a
+            read-only memory map (``numpy.load(out_file, mmap_mode="r")`` reads it later).
 
         Returns
         -------
@@ -150,9 +295,10 @@ class SystemRunner:
         if n_steps < 1:
             raise SystemError_(f"stop time {stop} s leaves no step of {sysd.step} s after start {t0} s")
         fields = self._record_fields(self.descriptions, record)  # refused before anything is instantiated
-        callbacks = self._callbacks()
+        callbacks = self._callbacks() if self.engine == "fmpy" else None
         tmp = Path(tempfile.mkdtemp(prefix="marinefmu_"))
-        instances: dict[str, _Instance] = {}
+        instances: dict[str, Any] = {}
+        recorder = None
         t = t0
         try:
             unzipped: dict[Path, Path] = {}
@@ -160,22 +306,17 @@ class SystemRunner:
                 src = comp.path(self.base_dir).resolve()
                 if src not in unzipped:
                     unzipped[src] = Path(extract(str(src), unzipdir=str(tmp / f"{len(unzipped)}_{src.stem}")))
-                instances[comp.name] = inst = _Instance(comp.name, self.descriptions[comp.name], unzipped[src], callbacks)
-                inst.fmu.setupExperiment(startTime=t0)
+                instances[comp.name] = inst = self._instantiate(comp, unzipped[src], callbacks)
+                inst.setup(t0)
                 for name, value in comp.parameters.items():
-                    inst.set_value(name, value)
-            # wiring (checked by check_system before anything was instantiated)
-            wires = []  # (end component, getter, source vr, setter, destination vr), resolved once
-            for con in sysd.connections:
-                a = instances[con.start].variable(con.start_var)
-                b = instances[con.end].variable(con.end_var)
-                wires.append((con.end, _accessor(instances[con.start].fmu, "get", a.type), [a.valueReference],
-                              _accessor(instances[con.end].fmu, "set", b.type), [b.valueReference]))
+                    v = lookup(inst.md, comp.name, name)   # type-checked by check_system
+                    cast = {"Real": float, "Integer": int, "Boolean": bool}.get(_fmi_type(v.type), str)
+                    inst.accessor("set", v.type)([v.valueReference], [cast(value)])
+            wires = self._wires(instances)
             for name, inst in instances.items():
                 logged = len(self.messages)
                 try:
-                    inst.fmu.enterInitializationMode()
-                    inst.fmu.exitInitializationMode()
+                    inst.initialise()
                 except Exception as exc:  # FMPy raises FMICallException
                     raise self._fail(name, "initialisation", t0, exc) from None
                 # marinefmu slaves refuse a parameter by logging an error (they never raise:
@@ -183,11 +324,12 @@ class SystemRunner:
                 refused = [m for m in self.messages[logged:] if m.instance == name and m.status in ("ERROR", "FATAL")]
                 if refused:
                     raise self._fail(name, "initialisation", t0, RuntimeError(refused[0].text))
-            out = np.zeros(n_steps + 1, dtype=[("time", "f8")] + [(f, "?" if k == "Boolean" else "f8") for f, (_, k, _) in fields.items()])
+            dtype = np.dtype([("time", "f8")] + [(f, "?" if k == "Boolean" else "f8") for f, (_, k, _) in fields.items()])
+            recorder = _Recorder(dtype, n_steps + 1, out_file)
             getters = self._getters(instances, fields)
             rates = {c.name: c.rate for c in sysd.components}
             self._transfer(wires, set(instances))
-            self._sample(out, 0, t0, getters)
+            self._sample(recorder.row(0), t0, getters)
             bar = tqdm(total=n_steps, unit="step", disable=not (progress if progress is not None else n_steps > 2000),
                        desc=sysd.name, mininterval=0.5)
             try:
@@ -197,20 +339,22 @@ class SystemRunner:
                     self._transfer(wires, due)
                     for name in due:
                         try:
-                            instances[name].fmu.doStep(currentCommunicationPoint=t, communicationStepSize=rates[name] * sysd.step)
+                            instances[name].do_step(t, rates[name] * sysd.step)
                         except Exception as exc:
                             raise self._fail(name, "doStep", t, exc) from None
-                    self._sample(out, k + 1, t0 + (k + 1) * sysd.step, getters)
+                    self._sample(recorder.row(k + 1), t0 + (k + 1) * sysd.step, getters)
                     bar.update(1)
             finally:
                 bar.close()
             for inst in instances.values():
-                inst.fmu.terminate()
-            return out
+                inst.terminate()
+            return recorder.finish()
         finally:
+            if recorder is not None:
+                recorder.close()
             for inst in instances.values():
                 try:
-                    inst.fmu.freeInstance()
+                    inst.free()
                 except Exception:  # noqa: BLE001 - freeing must go on for the others
                     log.exception("freeing %s failed", inst.name)
             shutil.rmtree(tmp, ignore_errors=True)
@@ -241,29 +385,51 @@ class SystemRunner:
             vrs, names = groups.setdefault((comp, kind), ([], []))
             vrs.append(vr)
             names.append(f)
-        result = []
-        for (comp, kind), (vrs, names) in groups.items():
-            result.append((_accessor(instances[comp].fmu, "get", kind), vrs, names))
-        return result
+        return [(instances[comp].accessor("get", kind), vrs, names) for (comp, kind), (vrs, names) in groups.items()]
 
     @staticmethod
-    def _sample(out: np.ndarray, row: int, t: float, getters) -> None:
-        out["time"][row] = t
+    def _sample(row: np.void, t: float, getters) -> None:
+        row["time"] = t
         for get, vrs, names in getters:
             for name, value in zip(names, get(vrs)):
-                out[name][row] = value
+                row[name] = value
+
+    def _wires(self, instances: dict[str, Any]) -> list:
+        """The connections (checked by check_system) batched for speed: per destination
+        component, one get per (source component, type) and one set per type, as
+        (destination, [(getter, source vrs, slice)], [(setter, destination vrs, slice)], n)."""
+        by_end: dict[str, list] = {}
+        for con in self.system.connections:
+            a = lookup(instances[con.start].md, con.start, con.start_var)
+            b = lookup(instances[con.end].md, con.end, con.end_var)
+            by_end.setdefault(con.end, []).append((con.start, _fmi_type(a.type), a.valueReference, b.valueReference))
+        wires = []
+        for end, items in by_end.items():
+            items.sort(key=lambda it: (it[0], it[1]))   # contiguous per source and type
+            gets, sets, pos = [], {}, 0
+            for (start, kind), group in itertools.groupby(items, key=lambda it: (it[0], it[1])):
+                group = list(group)
+                gets.append((instances[start].accessor("get", kind), [g[2] for g in group], slice(pos, pos + len(group))))
+                sets.setdefault(kind, []).extend((pos + i, g[3]) for i, g in enumerate(group))
+                pos += len(group)
+            setters = [(instances[end].accessor("set", kind), [vr for _, vr in pairs], [i for i, _ in pairs])
+                       for kind, pairs in sets.items()]
+            wires.append((end, gets, setters, pos))
+        return wires
 
     @staticmethod
     def _transfer(wires, due: set[str]) -> None:
         # read every due input's source first, then set: all inputs see the outputs held at t
-        values = [(set_, dst_vr, get(src_vr)) for end, get, src_vr, set_, dst_vr in wires if end in due]
-        for set_, dst_vr, value in values:
-            set_(dst_vr, value)
-
-
-def _accessor(fmu: Any, op: str, kind: str):
-    """The FMU2Slave method ``getReal``/``setBoolean``/… for a variable type."""
-    return getattr(fmu, f"{op}{'Integer' if kind == 'Enumeration' else kind}")
+        staged = []
+        for end, gets, setters, n in wires:
+            if end in due:
+                values: list = [None] * n
+                for get, vrs, where in gets:
+                    values[where] = get(vrs)
+                staged.append((setters, values))
+        for setters, values in staged:
+            for set_, vrs, idx in setters:
+                set_(vrs, [values[i] for i in idx])
 
 
 def save_csv(result: np.ndarray, path: str | Path) -> Path:

@@ -466,10 +466,14 @@ class HeaveObserver:
         if self.model is not None:
             t = carry_map(self.model.omega, new.omega, new.block)
             self.xp, self.x = t @ self.xp, t @ self.x
-            self.smoother.freeze(new.n)
-        self.model = new
+        self._use(new)
         self._variance = variance
         return True
+
+    def _use(self, model: BankModel) -> None:
+        """Make ``model`` the observer's (the smoother freezes the pending times)."""
+        self.model = model
+        self.smoother.set_model(model.heave_rows, model.P, model.closed_loop, model.C, model.S)
 
     def response(self, omega: Any) -> np.ndarray | None:
         """Heave response H(ω) of the current model (:meth:`.BankModel.heave_response`): the
@@ -518,16 +522,16 @@ class HeaveObserver:
             prev_a, state_aux = self.prev
             y = None if a_v is None or prev_a is None else 0.5 * (prev_a + a_v)
             self.prev = (a_v, aux)
-        sm.push(m.heave_rows, self.xp, m.P, state_aux)
+        sm.push(self.xp, state_aux)
         if y is None:
             post, phi = self.xp, m.A
             nxt = m.A @ post
         else:
             innovation = y - float(m.C @ self.xp)
             post = self.xp + m.K * innovation
-            sm.correct(m.C, innovation, m.S)
+            sm.correct(innovation)
             nxt = m.A_bar @ post + m.J * y
-            phi = m.closed_loop
+            phi = None   # the steady closed loop
         self._delayed = sm.pop()
         sm.propagate(phi)
         self.x = post if m.measurement == "paper" else nxt
@@ -578,7 +582,7 @@ class HeaveObserver:
         self.k, self.next_detect = int(s["k"]), int(s["next_detect"])
         self._variance = None if s["variance"] is None else np.array(s["variance"], dtype=float)
         if s["omega"] is not None:
-            self.model = self._build(np.array(s["omega"], dtype=float), self._variance)
+            self._use(self._build(np.array(s["omega"], dtype=float), self._variance))
         self.xp, self.x = np.array(s["xp"], dtype=float), np.array(s["x"], dtype=float)
         self.prev = None if s["prev"] is None else (s["prev"][0], np.array(s["prev"][1]))
         self.angles = [tuple(a) for a in s["angles"]]
