@@ -152,42 +152,46 @@ class _PythonComponent:
 
 
 class _Recorder:
-    """Rows of a result: a structured array in memory, or a ``.npy`` file written in chunks of
-    :data:`CHUNK_ROWS` rows (memory stays flat however long the run)."""
+    """Rows of a result, filled as plain floats (fast) and handed out as a structured array:
+    in memory, or written to a ``.npy`` file in chunks of :data:`CHUNK_ROWS` rows, so memory
+    stays flat however long the run."""
 
     def __init__(self, dtype: np.dtype, rows: int, out_file: str | Path | None) -> None:
         self.dtype, self.rows = dtype, rows
         self.path = None if out_file is None else Path(out_file)
-        if self.path is None:
-            self.out = np.zeros(rows, dtype=dtype)
-            self.buf = self.out
-        else:
+        self.buf = np.zeros((rows if self.path is None else min(rows, CHUNK_ROWS), len(dtype.names)))
+        if self.path is not None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.fh = open(self.path, "wb")
             np.lib.format.write_array_header_1_0(self.fh, {"descr": np.lib.format.dtype_to_descr(dtype),
                                                            "fortran_order": False, "shape": (rows,)})
-            self.buf = np.zeros(min(rows, CHUNK_ROWS), dtype=dtype)
-        self.filled = 0   # rows of buf in use (file mode)
-        self.written = 0  # rows already on disk
+        self.filled = 0   # rows of buf in use
 
-    def row(self, i: int) -> np.void:
-        """The row ``i`` to fill (rows come in order)."""
-        if self.path is None:
-            return self.buf[i]
+    def column(self, name: str) -> int:
+        """Index of a field in the rows handed out by :meth:`row`."""
+        return self.dtype.names.index(name)
+
+    def row(self) -> np.ndarray:
+        """The next row to fill (a float view, one column per field)."""
         if self.filled == len(self.buf):
             self._flush()
         self.filled += 1
         return self.buf[self.filled - 1]
 
+    def _structured(self) -> np.ndarray:
+        out = np.empty(self.filled, dtype=self.dtype)
+        for j, name in enumerate(self.dtype.names):
+            out[name] = self.buf[:self.filled, j]
+        return out
+
     def _flush(self) -> None:
-        self.fh.write(self.buf[:self.filled].tobytes())
-        self.written += self.filled
+        self.fh.write(self._structured().tobytes())
         self.filled = 0
 
     def finish(self) -> np.ndarray:
         """The result: the array, or the file opened read-only as a memory map."""
         if self.path is None:
-            return self.out
+            return self._structured()
         self._flush()
         self.fh.close()
         return np.load(self.path, mmap_mode="r")
@@ -326,10 +330,10 @@ class SystemRunner:
                     raise self._fail(name, "initialisation", t0, RuntimeError(refused[0].text))
             dtype = np.dtype([("time", "f8")] + [(f, "?" if k == "Boolean" else "f8") for f, (_, k, _) in fields.items()])
             recorder = _Recorder(dtype, n_steps + 1, out_file)
-            getters = self._getters(instances, fields)
+            getters = self._getters(instances, fields, recorder)
             rates = {c.name: c.rate for c in sysd.components}
             self._transfer(wires, set(instances))
-            self._sample(recorder.row(0), t0, getters)
+            self._sample(recorder.row(), t0, getters)
             bar = tqdm(total=n_steps, unit="step", disable=not (progress if progress is not None else n_steps > 2000),
                        desc=sysd.name, mininterval=0.5)
             try:
@@ -342,7 +346,7 @@ class SystemRunner:
                             instances[name].do_step(t, rates[name] * sysd.step)
                         except Exception as exc:
                             raise self._fail(name, "doStep", t, exc) from None
-                    self._sample(recorder.row(k + 1), t0 + (k + 1) * sysd.step, getters)
+                    self._sample(recorder.row(), t0 + (k + 1) * sysd.step, getters)
                     bar.update(1)
             finally:
                 bar.close()
@@ -379,20 +383,20 @@ class SystemRunner:
         return fields
 
     @staticmethod
-    def _getters(instances, fields):
-        groups: dict[tuple[str, str], tuple[list[int], list[str]]] = {}
+    def _getters(instances, fields, recorder: _Recorder) -> list:
+        """(getter, value references, columns) per (component, type) of the recorded fields."""
+        groups: dict[tuple[str, str], tuple[list[int], list[int]]] = {}
         for f, (comp, kind, vr) in fields.items():
-            vrs, names = groups.setdefault((comp, kind), ([], []))
+            vrs, cols = groups.setdefault((comp, kind), ([], []))
             vrs.append(vr)
-            names.append(f)
-        return [(instances[comp].accessor("get", kind), vrs, names) for (comp, kind), (vrs, names) in groups.items()]
+            cols.append(recorder.column(f))
+        return [(instances[comp].accessor("get", kind), vrs, np.array(cols)) for (comp, kind), (vrs, cols) in groups.items()]
 
     @staticmethod
-    def _sample(row: np.void, t: float, getters) -> None:
-        row["time"] = t
-        for get, vrs, names in getters:
-            for name, value in zip(names, get(vrs)):
-                row[name] = value
+    def _sample(row: np.ndarray, t: float, getters) -> None:
+        row[0] = t
+        for get, vrs, cols in getters:
+            row[cols] = get(vrs)
 
     def _wires(self, instances: dict[str, Any]) -> list:
         """The connections (checked by check_system) batched for speed: per destination
