@@ -17,6 +17,9 @@ def test_simulate_default_writes_csv_plots_and_system_file(fmu_dir, tmp_path, ca
     assert "hs_realised_m" in out and "summary of vessel" in out
     r = load_csv(tmp_path / "results.csv")
     assert r["time"][-1] == pytest.approx(20.0) and r.size == 2001
+    streamed = np.load(tmp_path / "results.npy")       # the same rows, streamed during the run
+    np.testing.assert_allclose(streamed["vessel.truth.cog.d"], r["vessel.truth.cog.d"], rtol=1e-9)
+    assert "engine fmpy" in out
     assert np.std(r["vessel.truth.cog.d"]) > 0.05
     for name in ("vessel_motion.png", "vessel_imu.png", "vessel_gnss.png", "SystemStructure.ssd"):
         assert (tmp_path / name).stat().st_size > 1000
@@ -54,3 +57,10 @@ def test_simulate_reports_a_missing_ssp_package_with_exit_code_2(tmp_path, capsy
 def test_console_script_is_installed():
     out = subprocess.run([sys.executable, "-m", "marinefmu.cli", "--help"], capture_output=True, text=True, check=True).stdout
     assert "simulate" in out and "build" in out and "bench" in out
+
+
+def test_simulate_in_process_engine(fmu_dir, tmp_path, capsys):
+    assert main(["simulate", "default", "--duration", "2", "--out", str(tmp_path), "--fmus", str(fmu_dir),
+                 "--no-progress", "--engine", "python"]) == 0
+    assert "engine python" in capsys.readouterr().out
+    assert np.load(tmp_path / "results.npy").size == 201

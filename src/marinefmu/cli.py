@@ -23,6 +23,10 @@ from pathlib import Path
 from .errors import MarineFmuError
 
 
+#: Longest result also written as CSV [rows] (an hour at 100 Hz); longer runs only as .npy.
+CSV_MAX_ROWS = 360_001
+
+
 def _cmd_build(args: argparse.Namespace) -> int:
     from .cosim.build import build_all
 
@@ -64,13 +68,18 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         ssp = write_ssp(scenario.system, fmu_dir, out / f"{scenario.name}.ssp")
         osp = write_osp_system(scenario.system, fmu_dir, out / "OspSystemStructure.xml")
         print(f"  SSP package {ssp} (run it with `marinefmu simulate {ssp}`); OSP libcosim system {osp}")
-    runner = SystemRunner(scenario.system, fmu_dir)
+    runner = SystemRunner(scenario.system, fmu_dir, engine=args.engine)
     t0 = time.perf_counter()
+    # streamed to disk as the run goes: memory stays flat however long the run
     result = runner.run(scenario.system.start_time + duration, record=scenario.record,
-                        progress=False if args.no_progress else None)
+                        progress=False if args.no_progress else None, out_file=out / "results.npy")
     wall = time.perf_counter() - t0
-    csv = save_csv(result, out / "results.csv")
-    print(f"  simulated in {wall:.1f} s ({(result.size - 1) / wall:,.0f} base steps/s); results {csv}")
+    print(f"  simulated in {wall:.1f} s ({(result.size - 1) / wall:,.0f} base steps/s, real-time factor "
+          f"{duration / wall:.1f}, engine {args.engine}); results {out / 'results.npy'} (numpy.load)")
+    if result.size <= CSV_MAX_ROWS:
+        print(f"  results as CSV {save_csv(result, out / 'results.csv')}")
+    else:
+        print(f"  no CSV: {result.size:,} rows is more than {CSV_MAX_ROWS:,} (use results.npy)")
     for comp in vessel_components(result):
         for p in plot_vessel(result, comp, out):
             print(f"  plot {p}")
@@ -155,6 +164,8 @@ def main(argv: list[str] | None = None) -> int:
     s.add_argument("--out", help="output folder (default results/<scenario name>)")
     s.add_argument("--fmus", help="folder holding the FMUs (default: build into the checkout's fmus/)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.add_argument("--engine", choices=("fmpy", "python"), default="fmpy",
+                   help="fmpy: the FMUs through FMI (default); python: their slave code in-process, without FMI")
     s.set_defaults(func=_cmd_simulate)
     k = sub.add_parser("bench", help="measure speed (writes JSON and prints a table)")
     k.add_argument("--out", default="bench", help="output folder for bench.json (default bench/)")
