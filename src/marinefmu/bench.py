@@ -10,9 +10,12 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 - ``in_process``: ``VesselMotionModel.step`` without FMI;
 - ``system_runner``: the FMPy system master recording every output.
 
-Then (``parts``): the paper 003 heave accuracy over five seas (:func:`heave_accuracy`), and
-the memory of every FMU over 10⁶ steps and over 1,000 instantiate/free cycles
-(:mod:`marinefmu.bench_memory`, issue 8).
+Then (``parts``): the paper 003 heave accuracy over five seas (:func:`heave_accuracy`),
+marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
+(``orcaflex``), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
+seas, speed under FMPy, in-process and libcosim, memory of a 3-hour run), and the memory of
+every FMU over 10⁶ steps and over 1,000 instantiate/free cycles (:mod:`marinefmu.bench_memory`,
+issue 8).
 """
 from __future__ import annotations
 
@@ -138,7 +141,7 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
 
 
 #: Parts of ``marinefmu bench``, in the order they run.
-PARTS = ("speed", "heave", "peer", "memory")
+PARTS = ("speed", "heave", "peer", "orcaflex", "system", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks: Hs [m], Tp [s]).
@@ -218,6 +221,17 @@ def peer_comparison(duration: float = 600.0) -> dict[str, dict]:
     return result
 
 
+def orcaflex_comparison() -> dict[str, dict[str, float]]:
+    """marinefmu and smsfusion on smsfusion's OrcaFlex record (:mod:`marinefmu.peer_orcaflex`)."""
+    from .peer_orcaflex import compare_orcaflex
+
+    scores = compare_orcaflex()
+    print("OrcaFlex record (smsfusion's test data, 10.24 Hz, 6 min), RMS errors from sample 600:")
+    for name, metrics in scores.items():
+        print(f"    {name:34s} " + ", ".join(f"{k} {v:.3f}" for k, v in metrics.items()), flush=True)
+    return scores
+
+
 def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = None,
                    memory_steps: int = 1_000_000, memory_cycles: int = 1000,
                    parts: tuple[str, ...] = PARTS) -> dict:
@@ -225,8 +239,10 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     part keeps its own date and machine, so parts can be re-measured one at a time) and print
     what they measure; return the whole file's data.
 
-    ``speed`` takes a few minutes, ``heave`` about five, ``peer`` about one, ``memory`` (``memory_steps`` steps
-    and ``memory_cycles`` cycles per FMU) about an hour on a 2-core machine."""
+    ``speed`` takes a few minutes, ``heave`` about five, ``peer`` about one, ``orcaflex`` a
+    few seconds, ``system`` (three seas, three engines and a 3-hour run) about an hour,
+    ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
+    2-core machine."""
     from .cosim.build import build_all, repo_root
 
     unknown = set(parts) - set(PARTS)
@@ -249,6 +265,12 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             data["heave"] = {**stamp, "seas": heave_accuracy()}
         elif part == "peer":
             data["peer"] = {**stamp, "seas": peer_comparison()}
+        elif part == "orcaflex":
+            data["orcaflex"] = {**stamp, "scores": orcaflex_comparison()}
+        elif part == "system":
+            from .bench_system import whole_system
+
+            data["system"] = {**stamp, **whole_system(fmu_dir, out_dir / "system_runs")}
         else:
             data["memory"] = {**stamp, "steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0,
                               "fmus": memory(fmu_dir, memory_steps, memory_cycles)}

@@ -1,0 +1,129 @@
+"""The whole system in the bench (issue 7): accuracy in three seas, speed under three engines,
+and memory over three hours.
+
+Every measurement runs in a fresh process (as :mod:`marinefmu.bench_memory` does: clean
+memory figures, and a native crash of one engine cannot take the bench down)::
+
+    python -m marinefmu.bench_system ENGINE FMU_DIR DURATION OUT_DIR [HS TP]
+
+with ENGINE ``fmpy`` (the FMUs through FMI with FMPy), ``python`` (the same slave code
+in-process without FMI, ``SystemRunner(engine="python")``) or ``libcosim`` (OSP libcosim from
+the scenario's ``OspSystemStructure.xml``), the ``system`` scenario at its 100 Hz base step
+(optionally in another sea: Hs [m], Tp [s]), its ``[record]`` list streamed to
+``OUT_DIR/results.npy`` (libcosim: sampled every second). It prints one JSON line: wall time
+[s], real-time factor, peak resident memory [MB] (``ru_maxrss``) and, for the runners that
+record every step, the accuracy table of :func:`marinefmu.scoring.score`.
+"""
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+#: Seas of the whole-system accuracy, calm / moderate / rough (Hs [m], Tp [s]), as the peer part.
+SYSTEM_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
+ENGINES = ("fmpy", "python", "libcosim")
+
+
+def _system(hs: float | None, tp: float | None):
+    from dataclasses import replace
+
+    from .scenarios import load_scenario
+
+    sc = load_scenario("system")
+    if hs is None:
+        return sc
+    comps = tuple(replace(c, parameters={**c.parameters, "sea.hs": hs, "sea.tp": tp}) if c.name == "vessel" else c
+                  for c in sc.system.components)
+    return replace(sc, system=replace(sc.system, components=comps))
+
+
+def measure(engine: str, fmu_dir: str, duration: float, out_dir: str, hs: float | None = None,
+            tp: float | None = None) -> dict:
+    """One run in this process (the worker's job); see the module docstring."""
+    sc = _system(hs, tp)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    # the estimators' imports (scipy, control, filterpy: seconds) happen once per process in
+    # every engine (the FMUs share this interpreter); done here, they stay out of the timing
+    import marinefmu.cosim.estimator_io  # noqa: F401
+    import marinefmu.estimators.heave  # noqa: F401
+    t0 = time.perf_counter()
+    scores = None
+    if engine == "libcosim":
+        from .cosim.libcosim_runner import run_libcosim
+
+        run_libcosim(sc.system, fmu_dir, out, duration, list(sc.record), 1.0)
+    else:
+        from .cosim.system import SystemRunner
+        from .scoring import score
+
+        result = SystemRunner(sc.system, fmu_dir, engine=engine).run(duration, record=sc.record, progress=False,
+                                                                      out_file=out / "results.npy")
+        wall = time.perf_counter() - t0
+        scores = score(result, sc.system, "vessel")
+    wall = time.perf_counter() - t0 if scores is None else wall
+    return {"engine": engine, "duration_s": duration, "wall_s": wall, "rtf": duration / wall,
+            "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, "scores": scores}
+
+
+def run_isolated(engine: str, fmu_dir: Path, duration: float, out_dir: Path, sea: tuple[float, float] | None = None,
+                 timeout: float = 4 * 3600.0) -> dict:
+    """:func:`measure` in a fresh Python process; its JSON result."""
+    cmd = [sys.executable, "-m", "marinefmu.bench_system", engine, str(fmu_dir), repr(duration), str(out_dir)]
+    if sea is not None:
+        cmd += [repr(sea[0]), repr(sea[1])]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    lines = [ln for ln in done.stdout.splitlines() if ln.startswith("{")]
+    if done.returncode != 0 or not lines:
+        raise RuntimeError(f"bench_system {engine} failed ({done.returncode}):\n{done.stdout[-2000:]}\n{done.stderr[-3000:]}")
+    return json.loads(lines[-1])
+
+
+def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_duration: float = 3 * 3600.0) -> dict:
+    """The bench part ``system``: accuracy per sea (FMPy runner, ``duration`` s each), speed of
+    the three engines on the default sea (``duration`` s each) with the FMI / in-process ratio,
+    and peak memory of a ``long_duration`` run under the FMPy runner (results streamed)."""
+    result: dict = {"seas": {}, "speed": {}}
+    for name, sea in SYSTEM_SEAS.items():
+        r = run_isolated("fmpy", fmu_dir, duration, work / f"sea_{name}", sea)
+        result["seas"][name] = {"hs_m": sea[0], "tp_s": sea[1], "scores": r["scores"]}
+        print(f"system, {name} sea (Hs {sea[0]:g} m, Tp {sea[1]:g} s), {duration:g} s: " + "; ".join(
+            f"{comp} " + ", ".join(f"{k} {v:.3g}" for k, v in m.items() if not k.endswith(("_s", "fraction")))
+            for comp, m in r["scores"].items()), flush=True)
+    for engine in ENGINES:
+        r = run_isolated(engine, fmu_dir, duration, work / f"speed_{engine}")
+        r.pop("scores", None)
+        result["speed"][engine] = r
+        print(f"system speed, {engine:8s}: {duration:g} s in {r['wall_s']:.1f} s, real-time factor {r['rtf']:.1f}, "
+              f"peak memory {r['peak_rss_mb']:.0f} MB", flush=True)
+    speed = result["speed"]
+    result["fmi_over_in_process"] = speed["python"]["rtf"] / speed["fmpy"]["rtf"]
+    print(f"FMI / in-process time ratio (FMPy runner / same code without FMI): {result['fmi_over_in_process']:.2f} "
+          "(goal <= 1.5)", flush=True)
+    if long_duration:
+        r = run_isolated("fmpy", fmu_dir, long_duration, work / "long")
+        r.pop("scores", None)
+        result["long_run"] = r
+        print(f"system, {long_duration / 3600:g} h under the FMPy runner, results streamed to disk: "
+              f"{r['wall_s']:.0f} s (real-time factor {r['rtf']:.1f}), peak memory {r['peak_rss_mb']:.0f} MB "
+              "(goal <= 500 MB)", flush=True)
+    result["goals"] = {"rtf_fmpy": 100.0, "fmi_over_in_process": 1.5, "peak_rss_mb_3h": 500.0}
+    return result
+
+
+def main(argv: list[str]) -> None:
+    engine, fmu_dir, duration, out_dir = argv[:4]
+    sea = (float(argv[4]), float(argv[5])) if len(argv) > 5 else (None, None)
+    if engine not in ENGINES:
+        raise SystemExit(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    print(json.dumps(measure(engine, fmu_dir, float(duration), out_dir, *sea)), flush=True)
+    os._exit(0)   # skip interpreter finalisation (pythonfmu at exit: README, known issues)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
