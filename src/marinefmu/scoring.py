@@ -7,7 +7,9 @@ samples where it is valid, against the matching ``truth.*`` outputs recorded in 
 FMU                         metrics (RMS errors)
 =========================  ====================================================================
 AttitudeEstimator           ``roll_deg``, ``pitch_deg`` (truth.roll, truth.pitch)
-GnssAccFusion               ``pos_n_cm``, ``pos_e_cm``, ``pos_d_cm`` (truth.cog)
+GnssAccFusion               ``pos_n_cm``, ``pos_e_cm``, ``pos_d_cm`` (truth.cog); with the
+                            antenna positions and ``gnss.new`` recorded, ``raw_gnss_*_cm``: the
+                            COG fixed from the antennas alone at each epoch
 HeaveObserver               ``heave_cm`` (truth.imu.d), ``point_heave_cm`` (truth.point.d), each
                             about its mean over the scored span as the observer has no mean;
                             ``heave_std_cm``, ``point_heave_std_cm`` of the truth for scale
@@ -47,6 +49,25 @@ def _span(result: np.ndarray, comp: str, settle: float) -> np.ndarray:
         return valid
     t = np.asarray(result["time"], dtype=float)
     return valid & (t >= t[np.argmax(valid)] + settle)
+
+
+def _raw_gnss(result: np.ndarray, comp, vessel: str, antennas: list[str], span: np.ndarray) -> dict[str, float]:
+    """RMS error [cm] per NED axis of the COG fixed from the raw antenna positions alone
+    (:func:`~.estimators.gnss_fusion.antenna_attitude` with the fusion's lever arms) at the
+    GNSS epochs in ``span``: the yardstick of issue 4's goal, fused error ≤ 0.5 × raw."""
+    from .estimators.gnss_fusion import DEFAULT_ANTENNAS, antenna_attitude
+
+    arms = np.array([[float(comp.parameters.get(f"ant{i + 1}.{a}", DEFAULT_ANTENNAS[i][j])) for j, a in enumerate("xyz")]
+                     for i in range(4)])
+    epochs = np.flatnonzero(np.asarray(result[f"{vessel}.gnss.new"], dtype=bool) & span)
+    pos = np.column_stack([np.asarray(result[n], dtype=float) for n in antennas])
+    err = []
+    for k in epochs:
+        fix = antenna_attitude(pos[k], arms)
+        if not isinstance(fix, str):
+            err.append(fix.cog - [float(result[f"{vessel}.truth.cog.{a}"][k]) for a in "ned"])
+    e = np.array(err).reshape(-1, 3)
+    return {f"raw_gnss_{a}_cm": 100.0 * _rms(e[:, i]) for i, a in enumerate("ned")}
 
 
 def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: float = 60.0) -> dict[str, dict[str, float]]:
@@ -93,6 +114,9 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
         elif kind == "GnssAccFusion" and has(f"{c}.pos.n", f"{v}.truth.cog.n"):
             for a in "ned":
                 row[f"pos_{a}_cm"] = 100.0 * _rms(f(f"{c}.pos.{a}")[m] - f(f"{v}.truth.cog.{a}")[m])
+            antennas = [f"{v}.gnss.ant{i}.{a}" for i in range(1, 5) for a in "ned"]
+            if has(*antennas, f"{v}.gnss.new"):
+                row.update(_raw_gnss(result, comp, v, antennas, m))
         elif kind == "HeaveObserver" and has(f"{c}.heave", f"{v}.truth.imu.d"):
             truth = f(f"{v}.truth.imu.d")[m]
             row["heave_cm"] = 100.0 * _rms(f(f"{c}.heave")[m] - _about_mean(truth))

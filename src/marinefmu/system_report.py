@@ -29,10 +29,15 @@ GOALS = {
     ("HeaveObserver", "point_heave_cm"): ("≤ max(2 cm, 2.5 % of std) (issue 6)",
                                           lambda s: s["point_heave_cm"] <= max(2.0, 0.025 * s["point_heave_std_cm"])),
     **{("CentreOfRotation", f"cr_{a}_m"): ("≤ 0.1 m (issue 5)", lambda s, a=a: s[f"cr_{a}_m"] <= 0.1) for a in "xyz"},
+    **{("GnssAccFusion", f"pos_{a}_cm"): ("≤ 0.5 × raw GNSS (issue 4)",
+                                         lambda s, a=a: None if f"raw_gnss_{a}_cm" not in s else s[f"pos_{a}_cm"] <= 0.5 * s[f"raw_gnss_{a}_cm"])
+       for a in "ned"},
 }
 LABELS = {
     "roll_deg": "roll RMS error [deg]", "pitch_deg": "pitch RMS error [deg]",
     "pos_n_cm": "COG north RMS error [cm]", "pos_e_cm": "COG east RMS error [cm]", "pos_d_cm": "COG down RMS error [cm]",
+    **{f"raw_gnss_{a}_cm": f"COG {w} from the antennas alone (raw GNSS), RMS error [cm]"
+       for a, w in zip("ned", ("north", "east", "down"))},
     "heave_cm": "heave at the IMU, RMS error [cm]", "heave_std_cm": "true heave std at the IMU [cm]",
     "point_heave_cm": "heave at the point, RMS error [cm]", "point_heave_std_cm": "true heave std at the point [cm]",
     "cr_x_m": "centre of rotation x, RMS error [m]", "cr_y_m": "centre of rotation y, RMS error [m]",
@@ -198,7 +203,8 @@ def accuracy_rows(system: SystemDescription, scores: dict[str, dict[str, float]]
     for comp, metrics in scores.items():
         for metric, value in metrics.items():
             goal = GOALS.get((kinds[comp], metric))
-            status = "" if goal is None or not math.isfinite(value) else ("met" if goal[1](metrics) else "not met")
+            verdict = None if goal is None or not math.isfinite(value) else goal[1](metrics)
+            status = "" if verdict is None else ("met" if verdict else "not met")
             rows.append((comp, LABELS.get(metric, metric), value, goal[0] if goal else "", status))
     return rows
 
