@@ -214,8 +214,11 @@ def _quick_system():
 def test_in_process_engine_equals_fmpy_bit_for_bit(fmu_dir):
     """engine="python" runs each FMU's own slave script without FMI: the same numbers."""
     sysd = _quick_system()
-    runs = {e: SystemRunner(sysd, fmu_dir, engine=e).run(40.0, progress=False) for e in ("python", "fmpy")}
+    runners = {e: SystemRunner(sysd, fmu_dir, engine=e) for e in ("python", "fmpy")}
+    runs = {e: r.run(40.0, progress=False) for e, r in runners.items()}
     a, b = runs["python"], runs["fmpy"]
+    for r in runners.values():   # the time each component spent stepping
+        assert set(r.step_seconds) == {c.name for c in sysd.components} and all(v > 0 for v in r.step_seconds.values())
     assert a.dtype == b.dtype and len(a) == 4001
     for name in a.dtype.names:
         np.testing.assert_array_equal(a[name], b[name], err_msg=name)

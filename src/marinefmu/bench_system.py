@@ -12,7 +12,8 @@ the scenario's ``OspSystemStructure.xml``), the ``system`` scenario at its 100 H
 (optionally in another sea: Hs [m], Tp [s]), its ``[record]`` list streamed to
 ``OUT_DIR/results.npy`` (libcosim: sampled every second). It prints one JSON line: wall time
 [s], real-time factor, peak resident memory [MB] (``ru_maxrss``) and, for the runners that
-record every step, the accuracy table of :func:`marinefmu.scoring.score`.
+record every step, the accuracy table of :func:`marinefmu.scoring.score` and each component's
+mean wall time per base step in its ``doStep`` [µs] (``SystemRunner.step_seconds``).
 """
 from __future__ import annotations
 
@@ -62,13 +63,15 @@ def measure(engine: str, fmu_dir: str, duration: float, out_dir: str, hs: float 
         from .cosim.system import SystemRunner
         from .scoring import score
 
-        result = SystemRunner(sc.system, fmu_dir, engine=engine).run(duration, record=sc.record, progress=False,
-                                                                      out_file=out / "results.npy")
+        runner = SystemRunner(sc.system, fmu_dir, engine=engine)
+        result = runner.run(duration, record=sc.record, progress=False, out_file=out / "results.npy")
         wall = time.perf_counter() - t0
+        steps = {name: 1e6 * sec / (len(result) - 1) for name, sec in runner.step_seconds.items()}
         scores = score(result, sc.system, "vessel")
     wall = time.perf_counter() - t0 if scores is None else wall
     return {"engine": engine, "duration_s": duration, "wall_s": wall, "rtf": duration / wall,
-            "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, "scores": scores}
+            "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, "scores": scores,
+            "step_us": None if scores is None else steps}
 
 
 def run_isolated(engine: str, fmu_dir: Path, duration: float, out_dir: Path, sea: tuple[float, float] | None = None,
@@ -100,7 +103,8 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
         r.pop("scores", None)
         result["speed"][engine] = r
         print(f"system speed, {engine:8s}: {duration:g} s in {r['wall_s']:.1f} s, real-time factor {r['rtf']:.1f}, "
-              f"peak memory {r['peak_rss_mb']:.0f} MB", flush=True)
+              f"peak memory {r['peak_rss_mb']:.0f} MB" + ("" if not r.get("step_us") else "; per base step in doStep: "
+              + ", ".join(f"{k} {v:.0f} µs" for k, v in r["step_us"].items())), flush=True)
     speed = result["speed"]
     result["fmi_over_in_process"] = speed["python"]["rtf"] / speed["fmpy"]["rtf"]
     print(f"FMI / in-process time ratio (FMPy runner / same code without FMI): {result['fmi_over_in_process']:.2f} "
