@@ -39,7 +39,7 @@ def test_scores_are_the_rms_errors_over_the_valid_settled_span():
     system = SystemDescription("s", tuple(Component(n, f"{k}.fmu") for n, k in (
         ("vessel", "VesselMotion"), ("att", "AttitudeEstimator"), ("heave", "HeaveObserver"), ("fusion", "GnssAccFusion"))),
         (Connection("vessel", "imu.acc.x", "att", "acc.x"),), 0.1, 200.0)
-    s = score(r, system, "vessel")
+    s = score(r, system, "vessel", delay=0)
     assert set(s) == {"att", "heave", "fusion"}
     assert s["att"]["roll_deg"] == pytest.approx(0.1, rel=1e-6)
     assert s["att"]["pitch_deg"] == pytest.approx(0.0, abs=1e-12)
@@ -60,3 +60,16 @@ def test_an_estimator_never_valid_has_no_error_metrics():
                                (), 0.1, 200.0)
     s = score(r, system, "vessel")
     assert s["att"]["valid_fraction"] == 0.0 and s["att"]["scored_s"] == 0.0 and math.isnan(s["att"]["roll_deg"])
+
+
+def test_estimates_are_compared_with_the_truth_one_communication_step_earlier():
+    """Jacobi coupling: the estimate recorded at t_{k+1} was computed from the vessel's
+    outputs at t_k; with delay = 1 an estimator that echoes the truth one row late scores 0."""
+    r, t = _result()
+    r["att.valid"] = np.ones_like(t, dtype=bool)
+    r["att.roll"] = np.r_[0.0, r["vessel.truth.roll"][:-1]]
+    r["att.pitch"] = np.r_[0.0, r["vessel.truth.pitch"][:-1]]
+    system = SystemDescription("s", (Component("vessel", "VesselMotion.fmu"), Component("att", "AttitudeEstimator.fmu")),
+                               (), 0.1, 200.0)
+    assert score(r, system, "vessel")["att"]["roll_deg"] == 0.0
+    assert score(r, system, "vessel", delay=0)["att"]["roll_deg"] > 0.01

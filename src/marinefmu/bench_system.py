@@ -87,17 +87,24 @@ def run_isolated(engine: str, fmu_dir: Path, duration: float, out_dir: Path, sea
     return json.loads(lines[-1])
 
 
-def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_duration: float = 3 * 3600.0) -> dict:
-    """The bench part ``system``: accuracy per sea (FMPy runner, ``duration`` s each), speed of
-    the three engines on the default sea (``duration`` s each) with the FMI / in-process ratio,
-    and peak memory of a ``long_duration`` run under the FMPy runner (results streamed)."""
-    result: dict = {"seas": {}, "speed": {}}
+def system_accuracy(fmu_dir: Path, work: Path, duration: float = 600.0) -> dict:
+    """Accuracy of every estimator of the ``system`` scenario in :data:`SYSTEM_SEAS` (FMPy
+    runner, ``duration`` s each, :func:`marinefmu.scoring.score`)."""
+    seas = {}
     for name, sea in SYSTEM_SEAS.items():
         r = run_isolated("fmpy", fmu_dir, duration, work / f"sea_{name}", sea)
-        result["seas"][name] = {"hs_m": sea[0], "tp_s": sea[1], "scores": r["scores"]}
+        seas[name] = {"hs_m": sea[0], "tp_s": sea[1], "scores": r["scores"]}
         print(f"system, {name} sea (Hs {sea[0]:g} m, Tp {sea[1]:g} s), {duration:g} s: " + "; ".join(
             f"{comp} " + ", ".join(f"{k} {v:.3g}" for k, v in m.items() if not k.endswith(("_s", "fraction")))
             for comp, m in r["scores"].items()), flush=True)
+    return seas
+
+
+def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_duration: float = 3 * 3600.0) -> dict:
+    """The bench part ``system``: accuracy per sea (:func:`system_accuracy`), speed of the three
+    engines on the default sea (``duration`` s each) with the FMI / in-process ratio, and peak
+    memory of a ``long_duration`` run under the FMPy runner (results streamed)."""
+    result: dict = {"seas": system_accuracy(fmu_dir, work, duration), "speed": {}}
     for engine in ENGINES:
         r = run_isolated(engine, fmu_dir, duration, work / f"speed_{engine}")
         r.pop("scores", None)

@@ -70,7 +70,8 @@ def _raw_gnss(result: np.ndarray, comp, vessel: str, antennas: list[str], span: 
     return {f"raw_gnss_{a}_cm": 100.0 * _rms(e[:, i]) for i, a in enumerate("ned")}
 
 
-def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: float = 60.0) -> dict[str, dict[str, float]]:
+def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: float = 60.0,
+          delay: int = 1) -> dict[str, dict[str, float]]:
     """Metrics of every estimator component of ``system`` (module docstring).
 
     Parameters
@@ -84,6 +85,11 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
         Name of the VesselMotion component whose truth is the reference.
     settle : float
         Time after ``valid`` first went true that is not scored [s].
+    delay : int
+        Communication delay [base steps] between the vessel and the estimators: under Jacobi
+        coupling (both runners) an estimator fed by the vessel outputs at t_{k+1} what it
+        computed from the vessel's outputs at t_k, so its output is compared with the truth
+        ``delay`` rows earlier (0 for records where estimates and truth share their time).
 
     Returns
     -------
@@ -97,7 +103,10 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
         return all(n in fields for n in names)
 
     def f(name: str) -> np.ndarray:
-        return np.asarray(result[name], dtype=float)
+        x = np.asarray(result[name], dtype=float)
+        if delay and name.startswith(f"{vessel}.truth."):   # the truth at the estimates' time
+            x = np.concatenate([np.full(delay, np.nan), x[:-delay]])
+        return x
 
     out: dict[str, dict[str, float]] = {}
     for comp in system.components:
@@ -105,6 +114,7 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
         if f"{comp.name}.valid" not in fields or comp.name == vessel:
             continue
         m = _span(result, comp.name, settle)
+        m[:delay] = False
         row = {"valid_fraction": float(np.mean(np.asarray(result[f"{comp.name}.valid"], dtype=bool))),
                "scored_s": float(np.sum(m) * (t[1] - t[0])) if len(t) > 1 else 0.0}
         c, v = comp.name, vessel
