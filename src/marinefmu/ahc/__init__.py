@@ -1,0 +1,1 @@
+"""Active heave compensation (issue 9): winch and load physics, controller, design."""

@@ -1,0 +1,198 @@
+"""An active-heave-compensation winch at a crane tip with a load on an elastic wire (issue 9).
+
+Frames and signs (DESIGN.md): NED, z down. The crane tip moves with the vessel (VesselMotion's
+``truth.point.d`` and ``truth.point_vel.d``); the winch there pays out wire of length L
+(positive, more wire = load lower); the load hangs at z below the tip.
+
+Model, states [L, v, a, z, ż]:
+
+- **Motor** (speed servo): the command u is clipped to ±``max_speed``; first order
+  v̇ = (u − v)/τ (``order=1``), or second order v̈ = ω_n²(u − v) − 2ζω_n v̇ (``order=2``); the
+  acceleration v̇ is clipped to ±``max_acc``. L̇ = v, held inside [``min_length``,
+  ``max_length``] (at a stop the speed into it is zeroed).
+- **Wire**: extension e = z − z_tip − L, tension T = k e + c ė (ė = ż − ż_tip − v), and a
+  wire cannot push: T ≥ 0 (``slack`` flags T = 0).
+- **Load**: m z̈ = m g − T.
+
+At rest the wire is stretched by e₀ = m g / k. Every limit that acts is reported by a flag
+(``speed_limited``, ``acc_limited``, ``stroke_limited``, ``slack``), never hidden.
+
+Integration: classical Runge-Kutta 4 on substeps of at most ``max_substep`` s (the wire-load
+mode is ω = √(k/m), 10 rad/s for the defaults; RK4 at 2 ms resolves it to 1e-9); the clips are
+continuous functions of the state, the stroke stops are applied after each substep.
+Hand-written (not ``scipy.integrate.solve_ivp``): a fixed-step co-simulation slave advances by
+a known step and must be cheap and deterministic per step.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, check_int, check_range
+
+G = 9.80665
+
+
+@dataclass(frozen=True)
+class WinchParams:
+    """Parameters of :class:`WinchLoadModel` (FMU names in brackets).
+
+    Parameters
+    ----------
+    order : int
+        Motor dynamics: 1 (first-order lag) or 2 (second order). [``order``]
+    tau : float
+        First-order time constant [s], (0, 10]. [``tau``]
+    omega_n, zeta : float
+        Second-order natural frequency [rad/s], (0, 1000], and damping ratio, (0, 10].
+        [``omega_n``, ``zeta``]
+    max_speed : float
+        Winch speed limit [m/s], > 0. [``max_speed``]
+    max_acc : float
+        Winch acceleration limit [m/s²], > 0. [``max_acc``]
+    min_length, max_length : float
+        Stroke: wire paid out [m], 0 ≤ min < max. [``min_length``, ``max_length``]
+    length0 : float
+        Initial wire length [m], in the stroke. [``length0``]
+    mass : float
+        Load mass [kg], > 0. [``mass``]
+    stiffness : float
+        Wire stiffness [N/m], > 0. [``stiffness``]
+    damping : float
+        Wire damping [N·s/m], ≥ 0. [``damping``]
+    max_substep : float
+        Longest integration substep [s], (0, 0.1]. [``max_substep``]
+    """
+
+    order: int = 1
+    tau: float = 0.1
+    omega_n: float = 20.0
+    zeta: float = 0.7
+    max_speed: float = 2.0
+    max_acc: float = 2.0
+    min_length: float = 10.0
+    max_length: float = 30.0
+    length0: float = 20.0
+    mass: float = 1.0e4
+    stiffness: float = 1.0e6
+    damping: float = 1.0e4
+    max_substep: float = 0.002
+
+    def __post_init__(self) -> None:
+        check_int("order", self.order, lo=1, hi=2)
+        check_range("tau", self.tau, lo=0.0, lo_open=True, hi=10.0, unit="s")
+        check_range("omega_n", self.omega_n, lo=0.0, lo_open=True, hi=1000.0, unit="rad/s")
+        check_range("zeta", self.zeta, lo=0.0, lo_open=True, hi=10.0)
+        check_range("max_speed", self.max_speed, lo=0.0, lo_open=True, hi=100.0, unit="m/s")
+        check_range("max_acc", self.max_acc, lo=0.0, lo_open=True, hi=1000.0, unit="m/s2")
+        check_range("min_length", self.min_length, lo=0.0, hi=1e4, unit="m")
+        check_range("max_length", self.max_length, lo=self.min_length, lo_open=True, hi=1e4, unit="m")
+        check_range("length0", self.length0, lo=self.min_length, hi=self.max_length, unit="m")
+        check_range("mass", self.mass, lo=0.0, lo_open=True, hi=1e9, unit="kg")
+        check_range("stiffness", self.stiffness, lo=0.0, lo_open=True, hi=1e12, unit="N/m")
+        check_range("damping", self.damping, lo=0.0, hi=1e12, unit="N*s/m")
+        check_range("max_substep", self.max_substep, lo=0.0, lo_open=True, hi=0.1, unit="s")
+
+    @property
+    def static_stretch(self) -> float:
+        """Wire extension at rest, m g / k [m]."""
+        return self.mass * G / self.stiffness
+
+
+@dataclass(frozen=True)
+class WinchState:
+    """Outputs after a step (NED, z down)."""
+
+    length: float          # wire paid out [m]
+    speed: float           # winch speed dL/dt [m/s]
+    acc: float             # winch acceleration [m/s²]
+    load: float            # load position, down [m]
+    load_vel: float        # load velocity, down [m/s]
+    tension: float         # wire tension [N]
+    speed_limited: bool    # the command exceeded max_speed during the step
+    acc_limited: bool      # the motor hit max_acc during the step
+    stroke_limited: bool   # the wire length sat at a stroke stop during the step
+    slack: bool            # the wire went slack (tension 0) during the step
+
+
+class WinchLoadModel:
+    """The winch, wire and load (module docstring), one co-simulation step at a time.
+
+    Parameters
+    ----------
+    params : WinchParams
+        Validated parameters.
+    tip : float
+        Crane-tip position at the start, down [m]: the load starts at rest below it.
+    """
+
+    def __init__(self, params: WinchParams | None = None, tip: float = 0.0) -> None:
+        self.params = params or WinchParams()
+        self.reset(tip)
+
+    def reset(self, tip: float = 0.0) -> None:
+        """At rest: the load hangs at tip + L₀ + m g / k."""
+        p = self.params
+        self.x = np.array([p.length0, 0.0, 0.0, tip + p.length0 + p.static_stretch, 0.0])
+        self.flags = [False] * 4
+        self.tension = p.mass * G
+        self.acc = 0.0
+
+    def _deriv(self, x: np.ndarray, u: float, tip: float, tip_vel: float) -> tuple[np.ndarray, float, bool]:
+        p = self.params
+        length, v, a, z, zd = x
+        if p.order == 1:
+            acc = (u - v) / p.tau
+        else:
+            acc = a
+        limited = abs(acc) > p.max_acc
+        acc = max(-p.max_acc, min(p.max_acc, acc))
+        if (length <= p.min_length and v < 0.0) or (length >= p.max_length and v > 0.0):
+            v_eff = 0.0
+        else:
+            v_eff = v
+        tension = p.stiffness * (z - tip - length) + p.damping * (zd - tip_vel - v_eff)
+        tension = max(tension, 0.0)
+        jerk = 0.0
+        if p.order == 2:
+            raw = p.omega_n ** 2 * (u - v) - 2.0 * p.zeta * p.omega_n * a
+            # a is held inside the acceleration limit: no further push against it
+            jerk = 0.0 if (a >= p.max_acc and raw > 0.0) or (a <= -p.max_acc and raw < 0.0) else raw
+        return np.array([v_eff, acc, jerk, zd, G - tension / p.mass]), tension, limited
+
+    def step(self, command: float, tip: float, tip_vel: float, dt: float) -> WinchState:
+        """Advance by ``dt`` [s] with speed command ``command`` [m/s] and the crane tip at
+        ``tip`` [m, down] moving at ``tip_vel`` [m/s] (both held over the step)."""
+        p = self.params
+        u = max(-p.max_speed, min(p.max_speed, float(command)))
+        flags = [abs(float(command)) > p.max_speed, False, False, False]
+        n = max(1, math.ceil(dt / p.max_substep - 1e-9))
+        h = dt / n
+        x = self.x
+        for _ in range(n):
+            k1, t1, l1 = self._deriv(x, u, tip, tip_vel)
+            k2, _, l2 = self._deriv(x + 0.5 * h * k1, u, tip, tip_vel)
+            k3, _, l3 = self._deriv(x + 0.5 * h * k2, u, tip, tip_vel)
+            k4, _, l4 = self._deriv(x + h * k3, u, tip, tip_vel)
+            x = x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            flags[1] |= l1 or l2 or l3 or l4
+            flags[3] |= t1 <= 0.0
+            if x[0] <= p.min_length or x[0] >= p.max_length:
+                x[0] = min(max(x[0], p.min_length), p.max_length)
+                if (x[0] == p.min_length and x[1] < 0.0) or (x[0] == p.max_length and x[1] > 0.0):
+                    x[1], x[2] = 0.0, 0.0
+                flags[2] = True
+        self.x = x
+        d, self.tension, _ = self._deriv(x, u, tip, tip_vel)
+        self.acc = float(d[1])
+        self.flags = flags
+        if not np.all(np.isfinite(x)):   # cannot happen for valid parameters; never pass NaN on
+            raise ParameterError("winch model diverged: check max_substep against sqrt(stiffness / mass)")
+        return self.state()
+
+    def state(self) -> WinchState:
+        """The current outputs."""
+        length, v, _, z, zd = (float(v) for v in self.x)
+        return WinchState(length, v, self.acc, z, zd, float(self.tension), *self.flags)

@@ -1,0 +1,89 @@
+"""The AHC winch and load model (issue 9) against analytic responses."""
+import math
+
+import numpy as np
+import pytest
+
+from marinefmu.ahc.winch import G, WinchLoadModel, WinchParams
+from marinefmu.errors import ParameterError
+
+
+def test_load_rings_as_the_damped_mass_on_a_spring():
+    """Winch held, tip still, load released 5 cm above its rest point: z(t) − z_eq is the
+    damped oscillation of m z̈ + c ż + k z = 0 (ω = √(k/m) = 10 rad/s, ζ = c/(2√(km)) = 0.05)."""
+    p = WinchParams()
+    m = WinchLoadModel(p)
+    z_eq = m.x[3]
+    m.x[3] -= 0.05
+    w, zeta = math.sqrt(p.stiffness / p.mass), p.damping / (2.0 * math.sqrt(p.stiffness * p.mass))
+    wd = w * math.sqrt(1.0 - zeta ** 2)
+    dt, err = 0.01, 0.0
+    for k in range(1, 301):
+        s = m.step(0.0, 0.0, 0.0, dt)
+        t = k * dt
+        exact = -0.05 * math.exp(-zeta * w * t) * (math.cos(wd * t) + zeta * w / wd * math.sin(wd * t))
+        err = max(err, abs(s.load - z_eq - exact))
+        assert not s.slack and s.length == p.length0
+    assert err < 1e-8, err
+
+
+def test_first_order_motor_follows_a_speed_step():
+    """v(t) = u (1 − e^{−t/τ}), L(t) = L₀ + u (t − τ (1 − e^{−t/τ})) below the limits."""
+    p = WinchParams(tau=0.2, max_acc=10.0)
+    m = WinchLoadModel(p)
+    for k in range(1, 101):
+        s = m.step(0.5, 0.0, 0.0, 0.01)
+        t = k * 0.01
+        assert s.speed == pytest.approx(0.5 * (1.0 - math.exp(-t / 0.2)), abs=1e-9)
+        assert s.length == pytest.approx(p.length0 + 0.5 * (t - 0.2 * (1.0 - math.exp(-t / 0.2))), abs=1e-9)
+        assert not (s.speed_limited or s.acc_limited or s.stroke_limited)
+
+
+def test_second_order_motor_step_settles_with_its_overshoot():
+    p = WinchParams(order=2, omega_n=10.0, zeta=0.5, max_acc=100.0)
+    m = WinchLoadModel(p)
+    v = [m.step(1.0, 0.0, 0.0, 0.01).speed for _ in range(300)]
+    overshoot = max(v) - 1.0
+    assert overshoot == pytest.approx(math.exp(-math.pi * 0.5 / math.sqrt(1 - 0.25)), rel=1e-3)   # 16.3 %
+    assert v[-1] == pytest.approx(1.0, abs=1e-4)
+
+
+def test_limits_act_and_are_flagged():
+    p = WinchParams(max_speed=1.0, max_acc=0.5, max_length=20.5)
+    m = WinchLoadModel(p)
+    s = m.step(3.0, 0.0, 0.0, 0.1)
+    assert s.speed_limited and s.acc_limited
+    assert s.speed == pytest.approx(0.05, abs=1e-9)          # 0.5 m/s² for 0.1 s
+    for _ in range(40):
+        s = m.step(1.0, 0.0, 0.0, 0.1)
+    assert s.stroke_limited and s.length == 20.5 and s.speed == 0.0
+
+
+def test_a_tip_dropping_faster_than_the_load_can_fall_slackens_the_wire():
+    """The tip drops at 4 m/s from rest: the load cannot follow faster than free fall, the
+    wire goes slack (tension 0, flagged, never negative) and takes the load again."""
+    m = WinchLoadModel(WinchParams())
+    slack, tensions = [], []
+    for k in range(100):
+        s = m.step(0.0, 4.0 * (k + 1) * 0.01, 4.0, 0.01)
+        slack.append(s.slack)
+        tensions.append(s.tension)
+    assert any(slack[:20]) and min(tensions) == 0.0 and not slack[-1] and tensions[-1] > 0.0
+
+
+def test_at_rest_the_wire_carries_the_load():
+    m = WinchLoadModel(WinchParams(), tip=-12.0)
+    s = m.step(0.0, -12.0, 0.0, 1.0)
+    assert s.tension == pytest.approx(1.0e4 * G) and s.load == pytest.approx(-12.0 + 20.0 + 1.0e4 * G / 1.0e6)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"stiffness": 0.0}, r"stiffness = 0\.0 is out of range"),
+    ({"max_speed": -1.0}, r"max_speed = -1\.0 is out of range"),
+    ({"max_acc": 0.0}, r"max_acc = 0\.0 is out of range"),
+    ({"min_length": 10.0, "max_length": 5.0}, r"max_length = 5\.0 is out of range"),
+    ({"order": 3}, r"order = 3 is out of range"),
+])
+def test_bad_parameters_name_the_cause(kwargs, match):
+    with pytest.raises(ParameterError, match=match):
+        WinchParams(**kwargs)
