@@ -87,3 +87,45 @@ def test_at_rest_the_wire_carries_the_load():
 def test_bad_parameters_name_the_cause(kwargs, match):
     with pytest.raises(ParameterError, match=match):
         WinchParams(**kwargs)
+
+
+def test_a_bad_input_is_held_flagged_and_never_passed_on():
+    good = WinchLoadModel(WinchParams())
+    bad = WinchLoadModel(WinchParams())
+    for k in range(50):
+        tip = 0.1 * math.sin(0.5 * k * 0.01)
+        a = good.step(0.2, tip, 0.0, 0.01)
+        corrupt = k == 20
+        b = bad.step(math.nan if corrupt else 0.2, math.inf if corrupt else tip, 0.0, 0.01)
+        assert b.valid is (not corrupt) and (b.warning is not None) is corrupt
+        assert all(math.isfinite(v) for v in (b.length, b.load, b.load_vel, b.tension))
+    assert abs(a.load - b.load) < 1e-3          # one held step changes little
+    state = bad.get_state()
+    again = WinchLoadModel(WinchParams())
+    again.set_state(state)
+    assert again.step(0.2, 0.0, 0.0, 0.01) == bad.step(0.2, 0.0, 0.0, 0.01)
+
+
+@pytest.mark.fmu
+def test_fmu_equals_the_in_process_model_under_vessel_motion(fmu_dir):
+    """AhcWinch.fmu hanging off VesselMotion's bow point (FMPy runner, no command): the same
+    numbers as WinchLoadModel fed the recorded tip motion (Jacobi: the inputs of step k are
+    the vessel's outputs at row k)."""
+    from marinefmu.cosim.ssp import Component, Connection, SystemDescription
+    from marinefmu.cosim.system import SystemRunner
+
+    sysd = SystemDescription("winch", (Component("vessel", "VesselMotion.fmu", {"sea.hs": 3.0}),
+                                       Component("winch", "AhcWinch.fmu", {"mass": 5.0e3})),
+                             (Connection.parse("vessel.truth.point.d", "winch.tip.d"),
+                              Connection.parse("vessel.truth.point_vel.d", "winch.tip_vel.d")), 0.01, 20.0)
+    r = SystemRunner(sysd, fmu_dir).run(record=["vessel.truth.point.d", "vessel.truth.point_vel.d", "winch.load.d",
+                                                "winch.tension", "winch.length", "winch.valid", "winch.slack"],
+                                        progress=False)
+    m = WinchLoadModel(WinchParams(mass=5.0e3), tip=float(r["vessel.truth.point.d"][0]))
+    load = [m.step(0.0, float(r["vessel.truth.point.d"][k]), float(r["vessel.truth.point_vel.d"][k]), 0.01).load
+            for k in range(len(r) - 1)]
+    np.testing.assert_array_equal(r["winch.load.d"][1:], load)
+    assert r["winch.valid"][1:].all() and not r["winch.slack"].any() and (r["winch.length"][1:] == 20.0).all()
+    # uncompensated, the load follows the tip: the wire only stretches by the dynamic load
+    tip = r["vessel.truth.point.d"][1:]
+    assert np.std(r["winch.load.d"][1:] - tip) < 0.05 * np.std(tip)

@@ -115,6 +115,8 @@ class WinchState:
     acc_limited: bool      # the motor hit max_acc during the step
     stroke_limited: bool   # the wire length sat at a stroke stop during the step
     slack: bool            # the wire went slack (tension 0) during the step
+    valid: bool = True     # the inputs of the step were usable
+    warning: str | None = None
 
 
 class WinchLoadModel:
@@ -135,6 +137,7 @@ class WinchLoadModel:
     def reset(self, tip: float = 0.0) -> None:
         """At rest: the load hangs at tip + L₀ + m g / k."""
         p = self.params
+        self.inputs = (0.0, float(tip), 0.0)   # last good command, tip, tip velocity
         self.x = np.array([p.length0, 0.0, 0.0, tip + p.length0 + p.static_stretch, 0.0])
         self.flags = [False] * 4
         self.tension = p.mass * G
@@ -164,8 +167,16 @@ class WinchLoadModel:
 
     def step(self, command: float, tip: float, tip_vel: float, dt: float) -> WinchState:
         """Advance by ``dt`` [s] with speed command ``command`` [m/s] and the crane tip at
-        ``tip`` [m, down] moving at ``tip_vel`` [m/s] (both held over the step)."""
+        ``tip`` [m, down] moving at ``tip_vel`` [m/s] (both held over the step).
+
+        A bad input (NaN, ±Inf, a command beyond 1000 m/s, a tip beyond 10 km or faster than
+        100 m/s) is not used: the last good value is held, and the result has ``valid`` False
+        and a ``warning``."""
         p = self.params
+        warning = _bad_input(command, tip, tip_vel)
+        if warning is None:
+            self.inputs = (float(command), float(tip), float(tip_vel))
+        command, tip, tip_vel = self.inputs
         u = max(-p.max_speed, min(p.max_speed, float(command)))
         flags = [abs(float(command)) > p.max_speed, False, False, False]
         n = max(1, math.ceil(dt / p.max_substep - 1e-9))
@@ -190,9 +201,30 @@ class WinchLoadModel:
         self.flags = flags
         if not np.all(np.isfinite(x)):   # cannot happen for valid parameters; never pass NaN on
             raise ParameterError("winch model diverged: check max_substep against sqrt(stiffness / mass)")
-        return self.state()
+        return self.state(warning is None, warning)
 
-    def state(self) -> WinchState:
+    def state(self, valid: bool = True, warning: str | None = None) -> WinchState:
         """The current outputs."""
         length, v, _, z, zd = (float(v) for v in self.x)
-        return WinchState(length, v, self.acc, z, zd, float(self.tension), *self.flags)
+        return WinchState(length, v, self.acc, z, zd, float(self.tension), *self.flags, valid, warning)
+
+    def get_state(self) -> dict:
+        """JSON-serialisable state."""
+        return {"x": self.x.tolist(), "flags": list(self.flags), "tension": self.tension, "acc": self.acc,
+                "inputs": list(self.inputs)}
+
+    def set_state(self, s: dict) -> None:
+        """Restore from :meth:`get_state`."""
+        self.x = np.array(s["x"], dtype=float)
+        self.flags = [bool(f) for f in s["flags"]]
+        self.tension, self.acc = float(s["tension"]), float(s["acc"])
+        self.inputs = tuple(float(v) for v in s["inputs"])
+
+
+def _bad_input(command: float, tip: float, tip_vel: float) -> str | None:
+    for name, value, bound in (("command", command, 1e3), ("tip", tip, 1e4), ("tip velocity", tip_vel, 100.0)):
+        if not math.isfinite(value):
+            return f"bad {name} {value!r} (not finite): holding the last good one"
+        if abs(value) > bound:
+            return f"bad {name} {value!r} (beyond ±{bound:g}): holding the last good one"
+    return None

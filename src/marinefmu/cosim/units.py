@@ -29,6 +29,10 @@ UNITS: dict[str, dict[str, int]] = {
     "m2*s": {"m": 2, "s": 1},
     "m/s2/sqrt(s)": {},
     "m/sqrt(s)": {},
+    "kg": {"kg": 1},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "N/m": {"kg": 1, "s": -2},
+    "N*s/m": {"kg": 1, "s": -1},
 }
 _ORDER = ("ModelExchange", "CoSimulation", "UnitDefinitions", "TypeDefinitions", "LogCategories",
           "DefaultExperiment", "VendorAnnotations", "ModelVariables", "ModelStructure")
