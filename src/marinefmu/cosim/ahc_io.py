@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..ahc.controller import ControllerParams
 from ..ahc.winch import WinchParams
 from ..interface import Variable, real, resolve
 
@@ -53,3 +54,32 @@ def winch_params(values: dict[str, Any]) -> WinchParams:
     """WinchParams from FMI-named values."""
     v = resolve(WINCH_PARAMETERS, values, "AhcWinch")
     return WinchParams(**{k: v[k] for k in (p.name for p in WINCH_PARAMETERS)})
+
+
+_C = ControllerParams()
+CONTROLLER_PARAMETERS: list[Variable] = [
+    real("length0", _C.length0, "m", "Nominal wire length, >= 0"),
+    real("k_ff", _C.k_ff, "", "Feedforward gain on the estimated tip heave and heave rate, [0, 2] (1: full compensation)"),
+    real("k_p", _C.k_p, "1/s", "Proportional gain on the wire-length error, >= 0"),
+    real("k_i", _C.k_i, "1/s2", "Integral gain on the wire-length error, >= 0"),
+    real("max_integral", _C.max_integral, "m*s", "Clamp of the integrated length error (anti-windup), > 0"),
+    real("heave_ref", _C.heave_ref, "m", "Mean down position in the heave input, removed (0 for a heave estimate; the point's z for truth)"),
+]
+CONTROLLER_INPUTS: list[Variable] = [
+    real("heave", 0.0, "m", "Estimated crane-tip heave, down (e.g. HeaveObserver point.heave)"),
+    real("heave_rate", 0.0, "m/s", "Estimated crane-tip heave rate, down (e.g. HeaveObserver point.heave_rate)"),
+    real("length", _C.length0, "m", "Measured wire length (AhcWinch length)"),
+]
+CONTROLLER_OUTPUTS: list[Variable] = [
+    real("command", 0.0, "m/s", "Winch speed command"),
+    real("length_ref", _C.length0, "m", "Wire-length reference, length0 - k_ff * (heave - heave_ref)"),
+]
+CONTROLLER_BOOLEANS: list[Variable] = [
+    Variable("valid", "boolean", False, "", "The step's inputs were usable (false: a NaN/Inf/absurd input was held)"),
+]
+
+
+def controller_params(values: dict[str, Any]) -> ControllerParams:
+    """ControllerParams from FMI-named values."""
+    v = resolve(CONTROLLER_PARAMETERS, values, "AhcController")
+    return ControllerParams(**{k: v[k] for k in (p.name for p in CONTROLLER_PARAMETERS)})

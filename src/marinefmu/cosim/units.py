@@ -33,6 +33,9 @@ UNITS: dict[str, dict[str, int]] = {
     "N": {"kg": 1, "m": 1, "s": -2},
     "N/m": {"kg": 1, "s": -2},
     "N*s/m": {"kg": 1, "s": -1},
+    "1/s": {"s": -1},
+    "1/s2": {"s": -2},
+    "m*s": {"m": 1, "s": 1},
 }
 _ORDER = ("ModelExchange", "CoSimulation", "UnitDefinitions", "TypeDefinitions", "LogCategories",
           "DefaultExperiment", "VendorAnnotations", "ModelVariables", "ModelStructure")
