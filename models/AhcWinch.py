@@ -39,9 +39,9 @@ else:
             if not self.started:   # at rest below the first tip position the host gives
                 self.model.reset(i["tip.d"] if abs(i["tip.d"]) < 1e4 else 0.0)
                 self.started = True
-            r = self.model.step(i["command"], i["tip.d"], i["tip_vel.d"], dt)
+            r = self.model.step(i["command"], i["tip.d"], i["tip_vel.d"], dt, (i["tip.n"], i["tip.e"]))
             self.io.warn(r.warning, t, r.valid)
-            self.io.set_outputs([r.length, r.speed, r.acc, i["tip.n"], i["tip.e"], r.load, r.load_vel, r.tension],
+            self.io.set_outputs([r.length, r.speed, r.acc, r.load_n, r.load_e, r.load, r.load_vel, r.tension],
                                 [r.speed_limited, r.acc_limited, r.stroke_limited, r.slack, r.valid])
 
         def _get_fmu_state(self):

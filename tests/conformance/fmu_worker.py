@@ -34,7 +34,11 @@ DT = 0.05                  # s, communication step of every case (20 Hz)
 RECORD_STEPS = 9400        # 470 s of VesselMotion output: warm-up + a 5-minute GNSS dropout + recovery
 OK, WARNING, DISCARD, ERROR, FATAL = range(5)
 FMUS = ("VesselMotion", "AttitudeEstimator", "DisplacementReconstructor", "GnssAccFusion", "CentreOfRotation",
-        "HeaveObserver")
+        "HeaveObserver", "AhcWinch", "AhcController")
+#: Inputs with no VesselMotion output of their name: (source output, offset added)
+ALIASES = {"tip.n": ("truth.point.n", 0.0), "tip.e": ("truth.point.e", 0.0), "tip.d": ("truth.point.d", 0.0),
+           "tip_vel.d": ("truth.point_vel.d", 0.0), "command": ("truth.point_vel.d", 0.0),
+           "heave": ("truth.point.d", 10.0), "heave_rate": ("truth.point_vel.d", 0.0), "length": ("truth.point.d", 30.0)}
 VESSEL = {"sea.hs": 2.5, "sea.tp": 8.0, "gnss.rate": 5.0, "imu.x": 5.0, "imu.z": -3.0}
 #: Parameters of each FMU for these cases: short windows so every estimator is valid within 70 s.
 PARAMS = {
@@ -44,14 +48,17 @@ PARAMS = {
     "GnssAccFusion": {"acc_lever_arm.x": 5.0, "acc_lever_arm.z": -3.0},
     "CentreOfRotation": {},
     "HeaveObserver": {"window": 60.0},
+    "AhcWinch": {},
+    "AhcController": {},
 }
 #: Steps until each FMU's outputs are valid with PARAMS (checked by the ``state`` case).
 WARM_UP = {"VesselMotion": 1, "AttitudeEstimator": 100, "DisplacementReconstructor": 1500, "GnssAccFusion": 200,
-           "CentreOfRotation": 200, "HeaveObserver": 1300}
+           "CentreOfRotation": 200, "HeaveObserver": 1300, "AhcWinch": 1, "AhcController": 1}
 #: A refused parameter per FMU (logging-off case).
 BAD_PARAMETER = {"VesselMotion": ("sea.hs", -1.0), "AttitudeEstimator": ("vel_sigma", -1.0),
                  "DisplacementReconstructor": ("window", 10.0), "GnssAccFusion": ("gate", 0.0),
-                 "CentreOfRotation": ("hp_cutoff", 0.0), "HeaveObserver": ("max_modes", 0)}
+                 "CentreOfRotation": ("hp_cutoff", 0.0), "HeaveObserver": ("max_modes", 0),
+                 "AhcWinch": ("stiffness", 0.0), "AhcController": ("k_p", -1.0)}
 
 
 _UNZIPPED: dict[str, Path] = {}
@@ -143,14 +150,17 @@ class Feed:
         names = list(data["names"])
         rec = data["values"]
 
-        def source(n: str) -> int:
+        def source(n: str) -> np.ndarray:
+            if n in ALIASES:
+                out, offset = ALIASES[n]
+                return rec[:, names.index(out)] + offset
             for cand in (f"imu.{n}", f"truth.{n}", n):
                 if cand in names:
-                    return names.index(cand)
+                    return rec[:, names.index(cand)]
             raise KeyError(f"{inst.name}: no VesselMotion output for input {n}")
 
-        self.real = {v.name: rec[:, source(v.name)] for v in inst.real_inputs}
-        self.bool = {v.name: rec[:, source(v.name)] > 0.5 for v in inst.bool_inputs}
+        self.real = {v.name: source(v.name) for v in inst.real_inputs}
+        self.bool = {v.name: source(v.name) > 0.5 for v in inst.bool_inputs}
         self.truth_cog = rec[:, [names.index(f"truth.cog.{a}") for a in "ned"]]
 
     def at(self, k: int) -> tuple[dict[str, float], dict[str, bool]]:
@@ -291,7 +301,7 @@ def case_state(name: str, fmu_dir: Path, work: Path) -> dict:
             "valid_at_save": valid_at_save, "restore_identical": same(first, rerun),
             "deserialize_identical": same(first, from_blob), "state_bytes": len(blob),
             # outputs that moved between k1 and k2: a restore of outputs alone could not repeat them
-            "outputs_moving": int(np.sum(np.ptp(np.asarray(first), axis=0) > 0))}
+            "outputs_moving": int(np.sum(np.ptp(np.asarray(first), axis=0) > 0)), "real_outputs": len(inst.real_outputs)}
 
 
 #: Parameters that make every input of an FMU used (CentreOfRotation ignores its angle inputs

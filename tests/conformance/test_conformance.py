@@ -117,7 +117,7 @@ def test_runs_from_a_clean_environment_without_the_source_tree(conformance, name
     assert fmpy_run["marinefmu_used"].startswith(fmpy_run["unzipped_to"]), fmpy_run
     assert "/resources/marinefmu/" in libcosim_run["marinefmu_used"], libcosim_run
     assert fmpy_run["finite"] and fmpy_run["steps"] == 200
-    assert libcosim_run["simulated"] and libcosim_run["finite"] and libcosim_run["outputs"] >= 3
+    assert libcosim_run["simulated"] and libcosim_run["finite"] and libcosim_run["outputs"] >= 2
 
 
 @cases("faults")
@@ -128,7 +128,7 @@ def test_bad_samples_are_rejected_flagged_logged_and_recovered_from(conformance,
     assert set(report) == {"nan", "inf", "-inf", "1e12"}
     for label, r in report.items():
         assert r["finite"], (label, r)
-        assert len(r["rows"]) >= 5, r  # every real input was tried (5 for HeaveObserver ... 18 for GnssAccFusion)
+        assert len(r["rows"]) >= 3, r  # every real input was tried (3 for AhcController ... 18 for GnssAccFusion)
         for row in r["rows"]:
             assert row == {**row, "status": 0, "valid": False, "warned": True, "recovered": True}, (label, row)
 
@@ -140,7 +140,7 @@ def test_fmu_state_save_restore_and_serialization_repeat_the_run(conformance, na
     assert r["valid_at_save"]
     assert r["restore_identical"] and r["deserialize_identical"], r
     # the restored run repeats outputs that kept changing, so the internal state came back too
-    assert r["outputs_moving"] >= 5, r
+    assert r["outputs_moving"] >= min(5, r["real_outputs"]), r
 
 
 @cases("two_instances")

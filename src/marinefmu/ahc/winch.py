@@ -117,6 +117,8 @@ class WinchState:
     slack: bool            # the wire went slack (tension 0) during the step
     valid: bool = True     # the inputs of the step were usable
     warning: str | None = None
+    load_n: float = 0.0    # load position, north: below the tip [m]
+    load_e: float = 0.0    # load position, east [m]
 
 
 class WinchLoadModel:
@@ -138,6 +140,7 @@ class WinchLoadModel:
         """At rest: the load hangs at tip + L₀ + m g / k."""
         p = self.params
         self.inputs = (0.0, float(tip), 0.0)   # last good command, tip, tip velocity
+        self.tip_ne = (0.0, 0.0)               # last good tip north, east
         self.x = np.array([p.length0, 0.0, 0.0, tip + p.length0 + p.static_stretch, 0.0])
         self.flags = [False] * 4
         self.tension = p.mass * G
@@ -165,17 +168,20 @@ class WinchLoadModel:
             jerk = 0.0 if (a >= p.max_acc and raw > 0.0) or (a <= -p.max_acc and raw < 0.0) else raw
         return np.array([v_eff, acc, jerk, zd, G - tension / p.mass]), tension, limited
 
-    def step(self, command: float, tip: float, tip_vel: float, dt: float) -> WinchState:
+    def step(self, command: float, tip: float, tip_vel: float, dt: float,
+             tip_ne: tuple[float, float] = (0.0, 0.0)) -> WinchState:
         """Advance by ``dt`` [s] with speed command ``command`` [m/s] and the crane tip at
-        ``tip`` [m, down] moving at ``tip_vel`` [m/s] (both held over the step).
+        ``tip`` [m, down] moving at ``tip_vel`` [m/s] (both held over the step); ``tip_ne`` is
+        the tip's north and east [m], where the load hangs (``load_n``, ``load_e``).
 
         A bad input (NaN, ±Inf, a command beyond 1000 m/s, a tip beyond 10 km or faster than
-        100 m/s) is not used: the last good value is held, and the result has ``valid`` False
+        100 m/s) is not used: the last good inputs are held, and the result has ``valid`` False
         and a ``warning``."""
         p = self.params
-        warning = _bad_input(command, tip, tip_vel)
+        warning = _bad_input(command, tip, tip_vel, *tip_ne)
         if warning is None:
             self.inputs = (float(command), float(tip), float(tip_vel))
+            self.tip_ne = (float(tip_ne[0]), float(tip_ne[1]))
         command, tip, tip_vel = self.inputs
         u = max(-p.max_speed, min(p.max_speed, float(command)))
         flags = [abs(float(command)) > p.max_speed, False, False, False]
@@ -198,7 +204,7 @@ class WinchLoadModel:
         self.x = x
         d, self.tension, _ = self._deriv(x, u, tip, tip_vel)
         self.acc = float(d[1])
-        self.flags = flags
+        self.flags = [bool(f) for f in flags]
         if not np.all(np.isfinite(x)):   # cannot happen for valid parameters; never pass NaN on
             raise ParameterError("winch model diverged: check max_substep against sqrt(stiffness / mass)")
         return self.state(warning is None, warning)
@@ -206,12 +212,12 @@ class WinchLoadModel:
     def state(self, valid: bool = True, warning: str | None = None) -> WinchState:
         """The current outputs."""
         length, v, _, z, zd = (float(v) for v in self.x)
-        return WinchState(length, v, self.acc, z, zd, float(self.tension), *self.flags, valid, warning)
+        return WinchState(length, v, self.acc, z, zd, float(self.tension), *self.flags, valid, warning, *self.tip_ne)
 
     def get_state(self) -> dict:
         """JSON-serialisable state."""
-        return {"x": self.x.tolist(), "flags": list(self.flags), "tension": self.tension, "acc": self.acc,
-                "inputs": list(self.inputs)}
+        return {"x": self.x.tolist(), "flags": [bool(f) for f in self.flags], "tension": float(self.tension), "acc": self.acc,
+                "inputs": list(self.inputs), "tip_ne": list(self.tip_ne)}
 
     def set_state(self, s: dict) -> None:
         """Restore from :meth:`get_state`."""
@@ -219,10 +225,12 @@ class WinchLoadModel:
         self.flags = [bool(f) for f in s["flags"]]
         self.tension, self.acc = float(s["tension"]), float(s["acc"])
         self.inputs = tuple(float(v) for v in s["inputs"])
+        self.tip_ne = tuple(float(v) for v in s["tip_ne"])
 
 
-def _bad_input(command: float, tip: float, tip_vel: float) -> str | None:
-    for name, value, bound in (("command", command, 1e3), ("tip", tip, 1e4), ("tip velocity", tip_vel, 100.0)):
+def _bad_input(command: float, tip: float, tip_vel: float, tip_n: float = 0.0, tip_e: float = 0.0) -> str | None:
+    for name, value, bound in (("command", command, 1e3), ("tip", tip, 1e4), ("tip velocity", tip_vel, 100.0),
+                               ("tip north", tip_n, 1e7), ("tip east", tip_e, 1e7)):
         if not math.isfinite(value):
             return f"bad {name} {value!r} (not finite): holding the last good one"
         if abs(value) > bound:
