@@ -4,7 +4,7 @@ and memory over three hours.
 Every measurement runs in a fresh process (as :mod:`marinefmu.bench_memory` does: clean
 memory figures, and a native crash of one engine cannot take the bench down)::
 
-    python -m marinefmu.bench_system ENGINE FMU_DIR DURATION OUT_DIR [HS TP]
+    python -m marinefmu.bench_system ENGINE FMU_DIR DURATION OUT_DIR [HS TP] [--no-score]
 
 with ENGINE ``fmpy`` (the FMUs through FMI with FMPy), ``python`` (the same slave code
 in-process without FMI, ``SystemRunner(engine="python")``) or ``libcosim`` (OSP libcosim from
@@ -43,9 +43,15 @@ def _system(hs: float | None, tp: float | None):
     return replace(sc, system=replace(sc.system, components=comps))
 
 
+def _peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
 def measure(engine: str, fmu_dir: str, duration: float, out_dir: str, hs: float | None = None,
-            tp: float | None = None) -> dict:
-    """One run in this process (the worker's job); see the module docstring."""
+            tp: float | None = None, scored: bool = True) -> dict:
+    """One run in this process (the worker's job); see the module docstring. ``peak_rss_mb``
+    is the peak of the run itself; scoring afterwards reads the whole memory-mapped result
+    (its pages count as resident), so ``scored=False`` leaves it out of a long run."""
     sc = _system(hs, tp)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -66,20 +72,23 @@ def measure(engine: str, fmu_dir: str, duration: float, out_dir: str, hs: float 
         runner = SystemRunner(sc.system, fmu_dir, engine=engine)
         result = runner.run(duration, record=sc.record, progress=False, out_file=out / "results.npy")
         wall = time.perf_counter() - t0
+        peak = _peak_rss_mb()
         steps = {name: 1e6 * sec / (len(result) - 1) for name, sec in runner.step_seconds.items()}
-        scores = score(result, sc.system, "vessel")
-    wall = time.perf_counter() - t0 if scores is None else wall
+        scores = score(result, sc.system, "vessel") if scored else {}
+    if engine == "libcosim":
+        wall, peak, steps = time.perf_counter() - t0, _peak_rss_mb(), None
     return {"engine": engine, "duration_s": duration, "wall_s": wall, "rtf": duration / wall,
-            "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, "scores": scores,
-            "step_us": None if scores is None else steps}
+            "peak_rss_mb": peak, "scores": scores, "step_us": steps}
 
 
 def run_isolated(engine: str, fmu_dir: Path, duration: float, out_dir: Path, sea: tuple[float, float] | None = None,
-                 timeout: float = 4 * 3600.0) -> dict:
+                 timeout: float = 4 * 3600.0, scored: bool = True) -> dict:
     """:func:`measure` in a fresh Python process; its JSON result."""
     cmd = [sys.executable, "-m", "marinefmu.bench_system", engine, str(fmu_dir), repr(duration), str(out_dir)]
     if sea is not None:
         cmd += [repr(sea[0]), repr(sea[1])]
+    if not scored:
+        cmd.append("--no-score")
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     lines = [ln for ln in done.stdout.splitlines() if ln.startswith("{")]
     if done.returncode != 0 or not lines:
@@ -117,8 +126,9 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
     print(f"FMI / in-process time ratio (FMPy runner / same code without FMI): {result['fmi_over_in_process']:.2f} "
           "(goal <= 1.5)", flush=True)
     if long_duration:
-        r = run_isolated("fmpy", fmu_dir, long_duration, work / "long")
+        r = run_isolated("fmpy", fmu_dir, long_duration, work / "long", scored=False)
         r.pop("scores", None)
+        (work / "long" / "results.npy").unlink(missing_ok=True)   # 0.6 GB
         result["long_run"] = r
         print(f"system, {long_duration / 3600:g} h under the FMPy runner, results streamed to disk: "
               f"{r['wall_s']:.0f} s (real-time factor {r['rtf']:.1f}), peak memory {r['peak_rss_mb']:.0f} MB "
@@ -128,11 +138,13 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
 
 
 def main(argv: list[str]) -> None:
+    scored = "--no-score" not in argv
+    argv = [a for a in argv if a != "--no-score"]
     engine, fmu_dir, duration, out_dir = argv[:4]
     sea = (float(argv[4]), float(argv[5])) if len(argv) > 5 else (None, None)
     if engine not in ENGINES:
         raise SystemExit(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
-    print(json.dumps(measure(engine, fmu_dir, float(duration), out_dir, *sea)), flush=True)
+    print(json.dumps(measure(engine, fmu_dir, float(duration), out_dir, *sea, scored=scored)), flush=True)
     os._exit(0)   # skip interpreter finalisation (pythonfmu at exit: README, known issues)
 
 
