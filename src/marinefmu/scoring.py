@@ -44,7 +44,7 @@ def _about_mean(x: np.ndarray) -> np.ndarray:
 
 def _span(result: np.ndarray, comp: str, settle: float) -> np.ndarray:
     """Boolean mask: valid, and at least ``settle`` s after valid first went true."""
-    valid = np.asarray(result[f"{comp}.valid"], dtype=bool)
+    valid = np.array(result[f"{comp}.valid"], dtype=bool)   # a copy: the result may be a read-only memory map
     if not valid.any():
         return valid
     t = np.asarray(result["time"], dtype=float)
