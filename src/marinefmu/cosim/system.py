@@ -67,7 +67,7 @@ def _fmi_type(kind: str) -> str:
 class _FmpyComponent:
     """One component as an FMU through FMPy's ``FMU2Slave``; messages arrive by callback."""
 
-    def __init__(self, name: str, md: Any, unzip_dir: Path, callbacks: Any, messages: list[FmuMessage]) -> None:
+    def __init__(self, name: str, md: Any, unzip_dir: Path, callbacks: Any) -> None:
         from fmpy.fmi2 import FMU2Slave
 
         self.name, self.md = name, md
@@ -267,7 +267,7 @@ class SystemRunner:
         md = self.descriptions[comp.name]
         if self.engine == "python":
             return _PythonComponent(comp.name, md, unzip_dir, self.messages)
-        return _FmpyComponent(comp.name, md, unzip_dir, callbacks, self.messages)
+        return _FmpyComponent(comp.name, md, unzip_dir, callbacks)
 
     def run(self, stop_time: float | None = None, record: Sequence[str] | None = None,
             progress: bool | None = None, out_file: str | Path | None = None) -> np.ndarray:
