@@ -60,23 +60,21 @@ def measure(engine: str, fmu_dir: str, duration: float, out_dir: str, hs: float 
     import marinefmu.cosim.estimator_io  # noqa: F401
     import marinefmu.estimators.heave  # noqa: F401
     t0 = time.perf_counter()
-    scores = None
+    scores, steps = None, None
     if engine == "libcosim":
         from .cosim.libcosim_runner import run_libcosim
 
         run_libcosim(sc.system, fmu_dir, out, duration, list(sc.record), 1.0)
+        wall, peak = time.perf_counter() - t0, _peak_rss_mb()
     else:
         from .cosim.system import SystemRunner
         from .scoring import score
 
         runner = SystemRunner(sc.system, fmu_dir, engine=engine)
         result = runner.run(duration, record=sc.record, progress=False, out_file=out / "results.npy")
-        wall = time.perf_counter() - t0
-        peak = _peak_rss_mb()
+        wall, peak = time.perf_counter() - t0, _peak_rss_mb()
         steps = {name: 1e6 * sec / (len(result) - 1) for name, sec in runner.step_seconds.items()}
         scores = score(result, sc.system, "vessel") if scored else {}
-    if engine == "libcosim":
-        wall, peak, steps = time.perf_counter() - t0, _peak_rss_mb(), None
     return {"engine": engine, "duration_s": duration, "wall_s": wall, "rtf": duration / wall,
             "peak_rss_mb": peak, "scores": scores, "step_us": steps}
 

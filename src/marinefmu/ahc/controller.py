@@ -16,10 +16,10 @@ holds the last good one and sets ``valid`` false; the integrator is clamped to Â
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from ..errors import check_range
+from ..estimators.samples import bad_scalar
 
 
 @dataclass(frozen=True)
@@ -82,11 +82,7 @@ class AhcController:
         """The command for the next ``dt`` s from the tip's heave [m] and heave rate [m/s]
         estimates and the wire length [m]."""
         p = self.params
-        warning = None
-        for name, value, bound in (("heave", heave, 1e3), ("heave rate", heave_rate, 1e3), ("length", length, 1e5)):
-            if not math.isfinite(value) or abs(value) > bound:
-                warning = f"bad {name} {value!r}: holding the last good one"
-                break
+        warning = bad_scalar((("heave", heave, 1e3), ("heave rate", heave_rate, 1e3), ("length", length, 1e5)))
         if warning is None:
             self.inputs = (float(heave), float(heave_rate), float(length))
         heave, heave_rate, length = self.inputs

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, check_int, check_range
+from ..estimators.samples import bad_scalar
 
 G = 9.80665
 
@@ -178,7 +179,8 @@ class WinchLoadModel:
         100 m/s) is not used: the last good inputs are held, and the result has ``valid`` False
         and a ``warning``."""
         p = self.params
-        warning = _bad_input(command, tip, tip_vel, *tip_ne)
+        warning = bad_scalar((("command", command, 1e3), ("tip", tip, 1e4), ("tip velocity", tip_vel, 100.0),
+                              ("tip north", tip_ne[0], 1e7), ("tip east", tip_ne[1], 1e7)))
         if warning is None:
             self.inputs = (float(command), float(tip), float(tip_vel))
             self.tip_ne = (float(tip_ne[0]), float(tip_ne[1]))
@@ -227,12 +229,3 @@ class WinchLoadModel:
         self.inputs = tuple(float(v) for v in s["inputs"])
         self.tip_ne = tuple(float(v) for v in s["tip_ne"])
 
-
-def _bad_input(command: float, tip: float, tip_vel: float, tip_n: float = 0.0, tip_e: float = 0.0) -> str | None:
-    for name, value, bound in (("command", command, 1e3), ("tip", tip, 1e4), ("tip velocity", tip_vel, 100.0),
-                               ("tip north", tip_n, 1e7), ("tip east", tip_e, 1e7)):
-        if not math.isfinite(value):
-            return f"bad {name} {value!r} (not finite): holding the last good one"
-        if abs(value) > bound:
-            return f"bad {name} {value!r} (beyond ±{bound:g}): holding the last good one"
-    return None

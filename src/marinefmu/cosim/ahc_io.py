@@ -52,8 +52,7 @@ WINCH_BOOLEANS: list[Variable] = [
 
 def winch_params(values: dict[str, Any]) -> WinchParams:
     """WinchParams from FMI-named values."""
-    v = resolve(WINCH_PARAMETERS, values, "AhcWinch")
-    return WinchParams(**{k: v[k] for k in (p.name for p in WINCH_PARAMETERS)})
+    return WinchParams(**resolve(WINCH_PARAMETERS, values, "AhcWinch"))   # FMI names = field names
 
 
 _C = ControllerParams()
@@ -81,5 +80,4 @@ CONTROLLER_BOOLEANS: list[Variable] = [
 
 def controller_params(values: dict[str, Any]) -> ControllerParams:
     """ControllerParams from FMI-named values."""
-    v = resolve(CONTROLLER_PARAMETERS, values, "AhcController")
-    return ControllerParams(**{k: v[k] for k in (p.name for p in CONTROLLER_PARAMETERS)})
+    return ControllerParams(**resolve(CONTROLLER_PARAMETERS, values, "AhcController"))   # FMI names = field names

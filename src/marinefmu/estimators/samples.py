@@ -3,6 +3,7 @@ is a sensor fault (the estimator coasts on its last good sample, see each ``step
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -32,4 +33,15 @@ def angles_beyond_limit(euler: np.ndarray) -> str | None:
         return f"roll or pitch beyond ±{math.degrees(MAX_TILT):.0f}°"
     if len(euler) > 2 and abs(euler[2]) > MAX_YAW:
         return f"yaw beyond ±{MAX_YAW:g} rad"
+    return None
+
+
+def bad_scalar(checks: Iterable[tuple[str, float, float]]) -> str | None:
+    """The first of (name, value, bound) whose value is not finite or beyond ±bound, as a
+    warning ("bad tip nan (not finite): holding the last good one"), or None."""
+    for name, value, bound in checks:
+        if not math.isfinite(value):
+            return f"bad {name} {value!r} (not finite): holding the last good one"
+        if abs(value) > bound:
+            return f"bad {name} {value!r} (beyond ±{bound:g}): holding the last good one"
     return None
