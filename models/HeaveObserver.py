@@ -6,7 +6,7 @@ from pythonfmu import Fmi2Slave
 from marinefmu import __version__
 from marinefmu.cosim.estimator_io import HEAVE_DISCRETE, HEAVE_INPUTS, HEAVE_OUTPUTS, HEAVE_PARAMETERS, heave_params
 from marinefmu.cosim.slave import SlaveIO
-from marinefmu.estimators.heave import HeaveObserver as Estimator
+from marinefmu.estimators.highpass_heave import heave_estimator
 
 
 if "HeaveObserver" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun
@@ -14,7 +14,7 @@ if "HeaveObserver" in globals():  # pythonfmu runs this file again for each inst
 else:
     class HeaveObserver(Fmi2Slave):
         author = "marinefmu developers"
-        description = "Adaptive heave observer with transfer to a remote point (paper 003)"
+        description = "Adaptive heave observer with transfer to a remote point (paper 003); model = highpass: the classical baseline"
         version = __version__
         license = "MIT"
 
@@ -27,7 +27,7 @@ else:
             self.io.start_time = start_time
 
         def exit_initialization_mode(self):
-            self.model = self.io.build(lambda values: Estimator(heave_params(values)))
+            self.model = self.io.build(lambda values: heave_estimator(heave_params(values)))
 
         def do_step(self, current_time, step_size):
             return self.io.step(self._step, current_time, step_size)

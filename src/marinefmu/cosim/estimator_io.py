@@ -207,7 +207,7 @@ _HV = HeaveObserverParams()
 HEAVE_PARAMETERS: list[Variable] = [
     real("window", _HV.window, "s", "Spectrum window, >= two periods of omega_min (4 pi/omega_min), <= 3600"),
     real("peak_interval", _HV.peak_interval, "s", "Time between peak detections (paper 003: T = 15 s), (0, 3600]"),
-    Variable("model", "string", _HV.model, "", f"Observer model: one of {', '.join(MODEL_CHOICES)} (spectrum-weighted comb of band-pass elements, or the paper's undamped modes at the peaks)"),
+    Variable("model", "string", _HV.model, "", f"Observer model: one of {', '.join(MODEL_CHOICES)} (spectrum-weighted comb of band-pass elements, the paper's undamped modes at the peaks, or the classical high-pass double integration as a baseline)"),
     Variable("max_modes", "integer", _HV.max_modes, "", "Most oscillator modes (model = peaks), 1..20"),
     Variable("elements", "integer", _HV.elements, "", "Grid size of the band model, 2..100"),
     real("damping", _HV.damping, "", "Damping ratio of the band elements' stages, (0, 1]"),
@@ -226,6 +226,8 @@ HEAVE_PARAMETERS: list[Variable] = [
     Variable("transfer", "string", _HV.transfer, "", f"Transfer to the point: one of {', '.join(TRANSFER_CHOICES)} (exact 3-D lever arm, or the paper's eqs. 10-11)"),
     *vec("point", "xyz", 0.0, "m", "Monitoring point relative to the IMU, body frame"),
     real("smoother_lag", _HV.smoother_lag, "s", "Delay of the delayed heave (fixed-lag smoother), [0, 120]"),
+    real("highpass_cutoff", _HV.highpass_cutoff, "rad/s", "Corner of the classical high-pass double integration (model = highpass), (0, omega_max)"),
+    Variable("highpass_order", "integer", _HV.highpass_order, "", "Butterworth order of the classical filter (model = highpass), 2..8"),
 ]
 HEAVE_INPUTS: list[Variable] = [
     real("acc.z", -9.80665, "m/s2", "Specific force along body z at the IMU"),
@@ -263,4 +265,5 @@ def heave_params(values: dict[str, Any]) -> HeaveObserverParams:
         spectrum_floor=v["spectrum_floor"], acc_noise=v["acc_noise"], mode_noise=v["mode_noise"], offset_noise=v["offset_noise"],
         discretisation=v["discretisation"], measurement=v["measurement"], vertical=v["vertical"],
         transfer=v["transfer"], point=(v["point.x"], v["point.y"], v["point.z"]), smoother_lag=v["smoother_lag"],
+        highpass_cutoff=v["highpass_cutoff"], highpass_order=v["highpass_order"],
     )

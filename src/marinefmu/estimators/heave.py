@@ -53,7 +53,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import check_choice, check_int, check_range, check_vector
+from ..errors import ParameterError, check_choice, check_int, check_range, check_vector
 from ..frames import G
 from .fixed_lag import FixedLagOutputs
 from .band_bank import band_elements, band_grid, build_band_bank
@@ -71,7 +71,7 @@ class _Silent:
         """Drop the message."""
 
 VERTICAL_CHOICES = ("ned", "tilt", "paper")
-MODEL_CHOICES = ("band", "peaks")
+MODEL_CHOICES = ("band", "peaks", "highpass")
 TRANSFER_CHOICES = ("exact", "paper")
 
 
@@ -87,7 +87,9 @@ class HeaveObserverParams:
     peak_interval : float
         Time between peak detections [s], (0, 3600] (paper: T = 15 s). [``peak_interval``]
     model : str
-        ``"band"`` (default) or ``"peaks"`` (the paper's modes), module docstring. [``model``]
+        ``"band"`` (default) or ``"peaks"`` (the paper's modes), module docstring; or
+        ``"highpass"``, the classical high-pass double integration
+        (:class:`~.highpass_heave.HighpassHeave`, a baseline, not this class). [``model``]
     max_modes : int
         Most oscillator modes, 1..20 (``model="peaks"``). [``max_modes``]
     omega_min, omega_max : float
@@ -127,6 +129,11 @@ class HeaveObserverParams:
         Monitoring point relative to the IMU, body frame [m]. [``point.{x,y,z}``]
     smoother_lag : float
         Delay of the delayed heave [s], [0, 120]. [``smoother_lag``]
+    highpass_cutoff : float
+        Corner of the classical filter [rad/s], (0, omega_max) (``model="highpass"``).
+        [``highpass_cutoff``]
+    highpass_order : int
+        Butterworth order of the classical filter, 2..8 (``model="highpass"``). [``highpass_order``]
     """
 
     window: float = 120.0
@@ -150,6 +157,8 @@ class HeaveObserverParams:
     transfer: str = "exact"
     point: tuple[float, float, float] = (0.0, 0.0, 0.0)
     smoother_lag: float = 5.0
+    highpass_cutoff: float = 0.1
+    highpass_order: int = 4
 
     def __post_init__(self) -> None:
         check_range("omega_min", self.omega_min, lo=0.0, hi=20.0, lo_open=True, unit="rad/s")
@@ -174,6 +183,9 @@ class HeaveObserverParams:
         check_choice("transfer", self.transfer, TRANSFER_CHOICES)
         check_vector("point", self.point, unit="m")
         check_range("smoother_lag", self.smoother_lag, lo=0.0, hi=120.0, unit="s")
+        check_range("highpass_cutoff", self.highpass_cutoff, lo=0.0, hi=self.omega_max, lo_open=True, hi_open=True,
+                    unit="rad/s")
+        check_int("highpass_order", self.highpass_order, lo=2, hi=8)
 
 
 # ---- stateless kernels ----------------------------------------------------------------------
@@ -332,6 +344,9 @@ class HeaveObserver:
 
     def __init__(self, params: HeaveObserverParams | None = None, *, quiet: bool = False) -> None:
         self.params = params or HeaveObserverParams()
+        if self.params.model == "highpass":
+            raise ParameterError("model = 'highpass' is the classical baseline, not an observer model: use "
+                                 "estimators.highpass_heave.HighpassHeave or heave_estimator(params)")
         self.log: Any = _Silent() if quiet else log
         self.reset()
 

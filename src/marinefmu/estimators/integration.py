@@ -110,15 +110,58 @@ def integrate_frequency(acc: np.ndarray, dt: float, band: tuple[float, float] | 
     return vel, disp
 
 
+def highpass_sections(cutoff: float, dt: float, order: int = 4, rate: bool = False) -> np.ndarray:
+    """Second-order sections of the classical heave filter H(s) = s^{order−2}/B(s) (or, with
+    ``rate``, the heave-rate filter s^{order−1}/B(s)), B the ``order``-th order Butterworth
+    polynomial with corner ``cutoff``, each section made discrete by the bilinear transform.
+
+    Sections (not one polynomial) because the poles sit within ω_cΔt ≈ 1e-3 of z = 1: in one
+    polynomial of order 4 rounding moves them by ~ε^{1/4} ≈ 1e-4, as far as they are from the
+    unit circle. Each conjugate pair (and a real pole) is its own section with s² (s) on top,
+    except the last pair, which carries 1 (rate: s): the double integration.
+
+    Parameters
+    ----------
+    cutoff : float
+        High-pass corner ω_c [rad/s], (0, π/dt).
+    dt : float
+        Sample interval [s], > 0.
+    order : int
+        Butterworth order, 2..8.
+    rate : bool
+        The heave-rate filter instead of the heave filter.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_sections, 6) in ``scipy.signal.sosfilt`` layout [b0, b1, b2, 1, a1, a2].
+    """
+    check_range("dt", dt, lo=0.0, lo_open=True, unit="s")
+    check_range("cutoff", cutoff, lo=0.0, hi=math.pi / dt, lo_open=True, hi_open=True, unit="rad/s")
+    check_int("order", order, lo=2, hi=8)
+    _, poles, _ = signal.butter(order, cutoff, btype="highpass", analog=True, output="zpk")
+    pairs = [p for p in poles if p.imag > 1e-12 * cutoff]
+    groups = [np.array([p, np.conj(p)]) for p in pairs] + [np.array([p]) for p in poles if abs(p.imag) <= 1e-12 * cutoff]
+    sections = []
+    for i, group in enumerate(groups):
+        zeros = len(group) - (0 if i else 2 - int(rate))        # the first pair integrates
+        z, p, k = signal.bilinear_zpk(np.zeros(zeros), group, 1.0, fs=1.0 / dt)
+        b, a = signal.zpk2tf(z, p, k)
+        b = np.concatenate([np.zeros(len(a) - len(b)), b])
+        sections.append(np.concatenate([np.pad(np.real(b), (0, 3 - len(b))), np.pad(np.real(a), (0, 3 - len(a)))]))
+    return np.array(sections)
+
+
 def highpass_double_integration(acc: np.ndarray, dt: float, cutoff: float, order: int = 4) -> np.ndarray:
     """Causal heave from acceleration by high-pass filtered double integration, the classical
     design of motion reference units (the baseline of paper 003's checks).
 
     The continuous filter is 1/s² (double integration) times an ``order``-th order Butterworth
     high pass at ``cutoff``, H(s) = s^{order−2}/B(s), proper and stable for order ≥ 2, made
-    discrete by the bilinear transform (``scipy.signal.bilinear``) and run by
-    ``scipy.signal.lfilter`` from rest. It has no drift, but its phase lead and gain loss near
-    the cutoff are errors on long waves.
+    discrete by the bilinear transform in second-order sections (:func:`highpass_sections`)
+    and run by ``scipy.signal.sosfilt`` from rest. It has no drift, but its phase lead and gain
+    loss near the cutoff are errors on long waves. The same filter runs sample by sample in
+    :class:`~.highpass_heave.HighpassHeave` (the HeaveObserver FMU's ``model = "highpass"``).
 
     Parameters
     ----------
@@ -136,11 +179,4 @@ def highpass_double_integration(acc: np.ndarray, dt: float, cutoff: float, order
     numpy.ndarray
         (N,) heave [m], same sign convention as ``acc``.
     """
-    check_range("cutoff", cutoff, lo=0.0, hi=math.pi / dt, lo_open=True, hi_open=True, unit="rad/s")
-    check_int("order", order, lo=2, hi=8)
-    _, den = signal.butter(order, cutoff, btype="highpass", analog=True)
-    num = np.zeros(order - 1)
-    num[0] = 1.0                                          # s^(order−2)
-    b, a = signal.bilinear(num, den, fs=1.0 / dt)
-    x = np.asarray(acc, dtype=float)
-    return signal.lfilter(b, a, x)
+    return signal.sosfilt(highpass_sections(cutoff, dt, order), np.asarray(acc, dtype=float))
