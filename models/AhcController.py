@@ -36,9 +36,9 @@ else:
 
         def _step(self, t, dt):
             i = self.io.inputs
-            r = self.model.step(i["heave"], i["heave_rate"], i["length"], dt)
+            r = self.model.step(i["heave"], i["heave_rate"], i["length"], dt, i["heave_valid"])
             self.io.warn(r.warning, t, r.valid)
-            self.io.set_outputs([r.command, r.length_ref], [r.valid])
+            self.io.set_outputs([r.command, r.length_ref, r.engagement], [r.command_limited, r.valid])
 
         def _get_fmu_state(self):
             return self.io.get_state(self.model)

@@ -147,27 +147,23 @@ class WinchLoadModel:
         self.tension = p.mass * G
         self.acc = 0.0
 
-    def _deriv(self, x: np.ndarray, u: float, tip: float, tip_vel: float) -> tuple[np.ndarray, float, bool]:
+    def _deriv(self, x: tuple[float, ...], u: float, tip: float, tip_vel: float
+               ) -> tuple[tuple[float, ...], float, bool]:
+        """State derivative, tension [N] and whether the acceleration limit acts (plain floats:
+        this runs 21 times a step)."""
         p = self.params
         length, v, a, z, zd = x
-        if p.order == 1:
-            acc = (u - v) / p.tau
-        else:
-            acc = a
+        acc = (u - v) / p.tau if p.order == 1 else a
         limited = abs(acc) > p.max_acc
         acc = max(-p.max_acc, min(p.max_acc, acc))
-        if (length <= p.min_length and v < 0.0) or (length >= p.max_length and v > 0.0):
-            v_eff = 0.0
-        else:
-            v_eff = v
-        tension = p.stiffness * (z - tip - length) + p.damping * (zd - tip_vel - v_eff)
-        tension = max(tension, 0.0)
+        v_eff = 0.0 if (length <= p.min_length and v < 0.0) or (length >= p.max_length and v > 0.0) else v
+        tension = max(p.stiffness * (z - tip - length) + p.damping * (zd - tip_vel - v_eff), 0.0)
         jerk = 0.0
         if p.order == 2:
             raw = p.omega_n ** 2 * (u - v) - 2.0 * p.zeta * p.omega_n * a
             # a is held inside the acceleration limit: no further push against it
             jerk = 0.0 if (a >= p.max_acc and raw > 0.0) or (a <= -p.max_acc and raw < 0.0) else raw
-        return np.array([v_eff, acc, jerk, zd, G - tension / p.mass]), tension, limited
+        return (v_eff, acc, jerk, zd, G - tension / p.mass), tension, limited
 
     def step(self, command: float, tip: float, tip_vel: float, dt: float,
              tip_ne: tuple[float, float] = (0.0, 0.0)) -> WinchState:
@@ -189,22 +185,24 @@ class WinchLoadModel:
         flags = [abs(float(command)) > p.max_speed, False, False, False]
         n = max(1, math.ceil(dt / p.max_substep - 1e-9))
         h = dt / n
-        x = self.x
+        x = tuple(float(v) for v in self.x)
+        f = self._deriv
         for _ in range(n):
-            k1, t1, l1 = self._deriv(x, u, tip, tip_vel)
-            k2, _, l2 = self._deriv(x + 0.5 * h * k1, u, tip, tip_vel)
-            k3, _, l3 = self._deriv(x + 0.5 * h * k2, u, tip, tip_vel)
-            k4, _, l4 = self._deriv(x + h * k3, u, tip, tip_vel)
-            x = x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            k1, t1, l1 = f(x, u, tip, tip_vel)
+            k2, _, l2 = f(tuple(xi + 0.5 * h * ki for xi, ki in zip(x, k1)), u, tip, tip_vel)
+            k3, _, l3 = f(tuple(xi + 0.5 * h * ki for xi, ki in zip(x, k2)), u, tip, tip_vel)
+            k4, _, l4 = f(tuple(xi + h * ki for xi, ki in zip(x, k3)), u, tip, tip_vel)
+            x = tuple(xi + (h / 6.0) * (a + 2.0 * b + 2.0 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4))
             flags[1] |= l1 or l2 or l3 or l4
             flags[3] |= t1 <= 0.0
             if x[0] <= p.min_length or x[0] >= p.max_length:
-                x[0] = min(max(x[0], p.min_length), p.max_length)
-                if (x[0] == p.min_length and x[1] < 0.0) or (x[0] == p.max_length and x[1] > 0.0):
-                    x[1], x[2] = 0.0, 0.0
+                length, v, a = min(max(x[0], p.min_length), p.max_length), x[1], x[2]
+                if (length == p.min_length and v < 0.0) or (length == p.max_length and v > 0.0):
+                    v, a = 0.0, 0.0
+                x = (length, v, a, x[3], x[4])
                 flags[2] = True
-        self.x = x
-        d, self.tension, _ = self._deriv(x, u, tip, tip_vel)
+        self.x = np.array(x)
+        d, self.tension, _ = f(x, u, tip, tip_vel)
         self.acc = float(d[1])
         self.flags = [bool(f) for f in flags]
         if not np.all(np.isfinite(x)):   # cannot happen for valid parameters; never pass NaN on

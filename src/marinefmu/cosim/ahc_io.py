@@ -62,19 +62,24 @@ CONTROLLER_PARAMETERS: list[Variable] = [
     real("k_p", _C.k_p, "1/s", "Proportional gain on the wire-length error, >= 0"),
     real("k_i", _C.k_i, "1/s2", "Integral gain on the wire-length error, >= 0"),
     real("max_integral", _C.max_integral, "m*s", "Clamp of the integrated length error (anti-windup), > 0"),
+    real("max_command", _C.max_command, "m/s", "Clip of the speed command (the winch's max_speed), > 0; no integration into the clip"),
     real("heave_ref", _C.heave_ref, "m", "Mean down position in the heave input, removed (0 for a heave estimate; the point's z for truth)"),
+    real("engage_time", _C.engage_time, "s", "Time for the feedforward to fade in while heave_valid (and out while not), [0, 600]"),
 ]
 CONTROLLER_INPUTS: list[Variable] = [
     real("heave", 0.0, "m", "Estimated crane-tip heave, down (e.g. HeaveObserver point.heave)"),
     real("heave_rate", 0.0, "m/s", "Estimated crane-tip heave rate, down (e.g. HeaveObserver point.heave_rate)"),
     real("length", _C.length0, "m", "Measured wire length (AhcWinch length)"),
+    Variable("heave_valid", "boolean", True, "", "The heave estimate is usable (e.g. HeaveObserver valid): the feedforward fades in"),
 ]
 CONTROLLER_OUTPUTS: list[Variable] = [
     real("command", 0.0, "m/s", "Winch speed command"),
-    real("length_ref", _C.length0, "m", "Wire-length reference, length0 - k_ff * (heave - heave_ref)"),
+    real("length_ref", _C.length0, "m", "Wire-length reference, length0 - k_ff * engagement * (heave - heave_ref)"),
+    real("engagement", 0.0, "", "Weight of the feedforward, 0 (off) .. 1 (full), ramped by heave_valid"),
 ]
 CONTROLLER_BOOLEANS: list[Variable] = [
-    Variable("valid", "boolean", False, "", "The step's inputs were usable (false: a NaN/Inf/absurd input was held)"),
+    Variable("command_limited", "boolean", False, "", "The command was clipped to max_command this step"),
+    Variable("valid", "boolean", False, "", "Full compensation with usable inputs (false while engagement < 1 or a NaN/Inf/absurd input was held)"),
 ]
 
 
