@@ -15,18 +15,220 @@ shake the load on its wire), searched on a grid. ``control.stability_margins`` g
 of the chosen loop, ``control.feedback`` its closed loop, whose poles must all lie in the left
 half-plane: a design that fails is refused with the cause named.
 
-Feedforward: k_ff = 1 (full compensation of the estimated heave rate).
+Feedforward: k_ff = 1 (full compensation of the estimated heave rate) by :func:`design`; with
+an identified estimator, :func:`fit_feedforward` picks the k_ff that minimises the predicted
+residual.
+
+**The estimator in the loop** (:func:`identify_response`): the transfer H(ω) from the true
+crane-tip heave to the estimate the controller receives is identified from a co-simulation
+record as H = S_xy/S_xx (Welch cross- and auto-spectra, ``scipy.signal.csd``/``welch``), with
+the coherence γ² saying where it can be trusted (where the sea has energy).
+
+**Residual** (:func:`residual_response`): the load hangs at tip + L (+ stretch) and follows
+it through the wire, W(s). The controller (``u = −k_ff r̂ + C(L_ref − L)``, L_ref = L₀ − k_ff ĥ)
+acts, in a Jacobi co-simulation with base step h, on inputs one step old and its command is
+held over the next step: a delay D = 1.5 h on every signal it passes on, inside the length
+loop too; the winch holds the tip's position over a step (h/2). So
+
+    load / tip = W (e^{−sh/2} − k_ff (A s H_r + B H_h)),
+    A = e^{−sD} P/(1 + P C e^{−sD}),  B = e^{−sD} P C/(1 + P C e^{−sD}),
+
+with H_h, H_r the estimator's heave and heave-rate responses (1 for the truth). Checked
+against the 30-min co-simulation of the built-in scenario ``ahc``: predicted 1.35 % and
+1.63 % of the tip's heave in the band for the truth-fed and the observer-fed loop, measured
+1.34 % and 1.64 % (without the delays the model said 0.9 % and 2.6 %). The predicted residual
+(:func:`predicted_residual`) weighs |…|² with the tip's heave spectrum and adds the estimates'
+noise (the part of them not linearly related to the truth).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .ahc.controller import ControllerParams
 from .ahc.winch import WinchParams
 from .errors import ParameterError, check_range
+
+
+@dataclass(frozen=True)
+class EstimatorResponse:
+    """An identified estimator: true crane-tip heave x → the heave ĥ and heave rate r̂ the
+    controller receives.
+
+    Attributes
+    ----------
+    omega : numpy.ndarray
+        Frequencies [rad/s].
+    spectrum : numpy.ndarray
+        One-sided PSD of the true heave S_xx [m²/(rad/s)].
+    heave, rate : numpy.ndarray
+        Complex H_h = S_xĥ/S_xx and H_r = S_xr̂/(jω S_xx): each estimate over what it
+        estimates (1 for a perfect estimator), as measured.
+    heave_psd, rate_psd, cross_psd : numpy.ndarray
+        S_ĥĥ, S_r̂r̂ and S_r̂ĥ (complex), for the part of the estimates not linearly related
+        to the truth (their noise) [m²/(rad/s)], [m²/s²/(rad/s)], [m²/s/(rad/s)].
+    coherence : numpy.ndarray
+        Magnitude-squared coherence of x and ĥ, [0, 1].
+    heave_model, rate_model : tuple of float
+        (gain, delay [s]) of H ≈ gain·e^{−jω·delay} fitted over :meth:`band` (weighted by
+        the spectrum: gain the weighted mean of |H|, delay the weighted slope of its phase):
+        the measured responses vary from bin to bin with the estimation noise, the models are
+        what the design uses.
+    """
+
+    omega: np.ndarray
+    spectrum: np.ndarray
+    heave: np.ndarray
+    rate: np.ndarray
+    heave_psd: np.ndarray
+    rate_psd: np.ndarray
+    cross_psd: np.ndarray
+    coherence: np.ndarray
+    heave_model: tuple[float, float] = (1.0, 0.0)
+    rate_model: tuple[float, float] = (1.0, 0.0)
+
+    def band(self, share: float = 0.99) -> np.ndarray:
+        """Boolean mask of the frequencies that hold the central ``share`` of the heave's
+        variance (where the identification means something)."""
+        c = np.cumsum(self.spectrum)
+        c = c / c[-1]
+        tail = 0.5 * (1.0 - share)
+        return (c >= tail) & (c <= 1.0 - tail)
+
+    @staticmethod
+    def evaluate(model: tuple[float, float], omega: np.ndarray) -> np.ndarray:
+        """A (gain, delay) model at ``omega`` [rad/s]."""
+        return model[0] * np.exp(-1j * np.asarray(omega, dtype=float) * model[1])
+
+
+def _fit(h: np.ndarray, w: np.ndarray, weight: np.ndarray) -> tuple[float, float]:
+    """(gain, delay) of gain·e^{−jω·delay} ≈ ``h`` (weighted mean of |h|, weighted slope of
+    its unwrapped phase through the origin)."""
+    phase = np.unwrap(np.angle(h))
+    return (float(np.sum(weight * np.abs(h)) / np.sum(weight)),
+            float(-np.sum(weight * w * phase) / np.sum(weight * w ** 2)))
+
+
+def identify_response(truth: np.ndarray, heave: np.ndarray, rate: np.ndarray, dt: float, segment: float = 100.0
+                      ) -> EstimatorResponse:
+    """The estimator's responses and noise from a true heave record and the estimates
+    (module docstring; Welch spectra, ``scipy.signal.csd``).
+
+    Parameters
+    ----------
+    truth, heave, rate : numpy.ndarray
+        (N,) true heave [m], and the heave [m] and heave rate [m/s] estimates as the
+        controller receives them, same times.
+    dt : float
+        Sample interval [s].
+    segment : float
+        Welch segment [s] (resolution 2π/segment rad/s), at most half the record.
+
+    Raises
+    ------
+    ParameterError
+        For records of different lengths, non-finite samples, or a record shorter than two
+        segments.
+    """
+    from scipy import signal
+
+    x, y, r = (np.asarray(v, dtype=float) for v in (truth, heave, rate))
+    if not (x.shape == y.shape == r.shape and x.ndim == 1):
+        raise ParameterError(f"truth, heave and rate must be 1-D of one length, got {x.shape}, {y.shape}, {r.shape}")
+    if not all(np.all(np.isfinite(v)) for v in (x, y, r)):
+        raise ParameterError("truth or estimates hold NaN/Inf: identify on the estimator's valid span")
+    check_range("segment", segment, lo=0.0, hi=0.5 * len(x) * dt, lo_open=True, unit="s (half the record)")
+    n = int(round(segment / dt))
+    fs = 1.0 / dt
+    x, y, r = x - x.mean(), y - y.mean(), r - r.mean()
+
+    def csd(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return signal.csd(a, b, fs=fs, nperseg=n)
+
+    f, pxx = csd(x, x)
+    pxx = np.real(pxx)
+    keep = (f > 0) & (pxx > 0)
+    w = 2 * math.pi * f[keep]
+    scale = 1.0 / (2 * math.pi)
+    pxx = pxx[keep]
+    pxy, pxr, pyy, prr, pry = (csd(a, b)[1][keep] for a, b in ((x, y), (x, r), (y, y), (r, r), (r, y)))
+    resp = EstimatorResponse(w, pxx * scale, pxy / pxx, pxr / (1j * w * pxx), np.real(pyy) * scale,
+                             np.real(prr) * scale, pry * scale, np.abs(pxy) ** 2 / (pxx * np.real(pyy)))
+    m = resp.band()
+    weight = resp.spectrum[m]
+    return replace(resp, heave_model=_fit(resp.heave[m], w[m], weight), rate_model=_fit(resp.rate[m], w[m], weight))
+
+
+def _freq(sys, s: np.ndarray) -> np.ndarray:
+    """Frequency response of a ``control`` system at the points ``s``."""
+    return np.array([complex(sys(z)) for z in s])
+
+
+def _paths(s: np.ndarray, winch: WinchParams, ctrl: ControllerParams, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """(A, B): the wire length is L = −k_ff (A·r̂ + B·ĥ), with the controller's delay
+    D = 1.5·``step`` (module docstring): A = e^{−sD} P/(1 + P C e^{−sD}),
+    B = e^{−sD} P C/(1 + P C e^{−sD}) (rate feedforward and the closed length loop)."""
+    p = _freq(winch_tf(winch), s)
+    c = ctrl.k_p + ctrl.k_i / s
+    lag = np.exp(-1.5 * step * s)
+    d = lag / (1.0 + p * c * lag)
+    return d * p, d * p * c
+
+
+def residual_response(omega: np.ndarray, winch: WinchParams, ctrl: ControllerParams,
+                      estimator: tuple[np.ndarray, np.ndarray] | None = None, step: float = 0.0) -> np.ndarray:
+    """Load heave / tip heave at ``omega`` [rad/s] (module docstring), complex:
+    W (e^{−s·step/2} − k_ff (A s H_r + B H_h)).
+
+    ``estimator`` is (H_h, H_r) at ``omega`` (None: the truth, both 1); ``step`` the
+    co-simulation's base step [s] (0: continuous)."""
+    s = 1j * np.asarray(omega, dtype=float)
+    a, b = _paths(s, winch, ctrl, step)
+    hh, hr = (1.0, 1.0) if estimator is None else estimator
+    return _freq(load_tf(winch), s) * (np.exp(-0.5 * step * s) - ctrl.k_ff * (a * s * hr + b * hh))
+
+
+def _noise(resp: EstimatorResponse, m: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """PSD of the part of v = A r̂ + B ĥ not linearly related to the truth."""
+    s = 1j * resp.omega[m]
+    svv = (np.abs(a) ** 2 * resp.rate_psd[m] + np.abs(b) ** 2 * resp.heave_psd[m]
+           + 2.0 * np.real(np.conj(a) * b * resp.cross_psd[m]))
+    sxv = resp.spectrum[m] * (a * s * resp.rate[m] + b * resp.heave[m])
+    return np.maximum(svv - np.abs(sxv) ** 2 / resp.spectrum[m], 0.0)
+
+
+def predicted_residual(resp: EstimatorResponse, winch: WinchParams, ctrl: ControllerParams, step: float = 0.0,
+                       estimator: bool = True) -> float:
+    """Predicted load heave / tip heave [-] over the identified heave band: the models' part
+    Σ S_xx |:func:`residual_response`|² plus the estimates' noise k_ff² Σ |W|² S_vv,noise,
+    over Σ S_xx; ``estimator=False`` for a truth-fed loop."""
+    m = resp.band()
+    w = resp.omega[m]
+    s = 1j * w
+    models = (resp.evaluate(resp.heave_model, w), resp.evaluate(resp.rate_model, w)) if estimator else None
+    total = np.sum(resp.spectrum[m] * np.abs(residual_response(w, winch, ctrl, models, step)) ** 2)
+    if estimator:
+        a, b = _paths(s, winch, ctrl, step)
+        total += ctrl.k_ff ** 2 * np.sum(np.abs(_freq(load_tf(winch), s)) ** 2 * _noise(resp, m, a, b))
+    return float(np.sqrt(total / np.sum(resp.spectrum[m])))
+
+
+def fit_feedforward(resp: EstimatorResponse, winch: WinchParams, ctrl: ControllerParams, step: float = 0.0
+                    ) -> ControllerParams:
+    """``ctrl`` with the k_ff in [0, 2] that minimises :func:`predicted_residual` (closed
+    form: with F = A s H_r + B H_h from the models and W the wire load,
+    k = Re Σ S|W|² conj(F) e^{−s·step/2} / (Σ S|W|²|F|² + Σ |W|² S_vv,noise))."""
+    m = resp.band()
+    w = resp.omega[m]
+    s = 1j * w
+    a, b = _paths(s, winch, ctrl, step)
+    f = a * s * resp.evaluate(resp.rate_model, w) + b * resp.evaluate(resp.heave_model, w)
+    load = np.abs(_freq(load_tf(winch), s)) ** 2
+    k = float(np.real(np.sum(resp.spectrum[m] * load * np.conj(f) * np.exp(-0.5 * step * s)))
+              / (np.sum(resp.spectrum[m] * load * np.abs(f) ** 2) + np.sum(load * _noise(resp, m, a, b))))
+    return replace(ctrl, k_ff=min(2.0, max(0.0, k)))
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ Examples
     marinefmu bench
     marinefmu example --list
     marinefmu example paper001-fig7 --out results/examples
+    marinefmu design-ahc ahc --out results/ahc_design --write
 """
 from __future__ import annotations
 
@@ -19,6 +20,8 @@ import logging
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 from .errors import MarineFmuError
 
@@ -125,6 +128,74 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_design_ahc(args: argparse.Namespace) -> int:
+    import shutil
+
+    from .ahc_loop import GAINS, design_loop, find_loop, write_gains
+    from .scenarios import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    out = Path(args.out)
+    fmu_dir = Path(args.fmus) if args.fmus else None
+    if fmu_dir is None:
+        from .cosim.build import build_all, repo_root
+
+        build_all(verbose=False)
+        fmu_dir = repo_root() / "fmus"
+    controller = args.controller
+    if controller is None:   # the controller fed by a heave observer (not the classical filter)
+        kinds = {c.name: c for c in scenario.system.components}
+        for c in scenario.system.components:
+            if c.kind == "AhcController":
+                src = find_loop(scenario.system, c.name).estimator
+                if kinds[src].kind == "HeaveObserver" and kinds[src].parameters.get("model") != "highpass":
+                    controller = c.name
+                    break
+        if controller is None:
+            raise MarineFmuError(f"scenario {scenario.name}: no AhcController fed by a HeaveObserver; name one with --controller")
+    print(f"design-ahc: scenario {scenario.name}, controller {controller}")
+    t0 = time.perf_counter()
+    r = design_loop(scenario, controller, fmu_dir, out, args.identify, args.verify, args.phase_margin,
+                    progress=not args.no_progress)
+    total = time.perf_counter() - t0
+    d, c = r.design, r.design.controller
+    resp = r.response
+    print(f"  identified {find_loop(scenario.system, controller).estimator} over the heave band "
+          f"{resp.omega[resp.band()][0]:.2f}-{resp.omega[resp.band()][-1]:.2f} rad/s: heave gain {resp.heave_model[0]:.4f}, "
+          f"delay {1000 * resp.heave_model[1]:.1f} ms; heave rate gain {resp.rate_model[0]:.4f}, "
+          f"delay {1000 * resp.rate_model[1]:.1f} ms")
+    print(f"  tuned: k_p {c.k_p:.4g} /s, k_i {c.k_i:.4g} /s², k_ff {c.k_ff:.4g}; crossover {d.crossover:.3g} rad/s, "
+          f"phase margin {d.phase_margin:.1f}°, gain margin {d.gain_margin:.3g}")
+    print(f"  predicted residual heave {r.predicted_pct:.2f} % of the tip's (fed the truth: {r.predicted_ideal_pct:.2f} %)")
+    m = r.measured
+    if "residual_pct" in m:
+        print(f"  verified in co-simulation ({m['scored_s']:.0f} s scored): residual heave {m['residual_pct']:.2f} %, "
+              f"all frequencies {m['residual_total_pct']:.2f} %, a winch limit acting {m.get('limited_pct', 0.0):.2f} % of the time")
+    for p in r.plots:
+        print(f"  plot {p}")
+    if args.write:
+        target = Path(args.scenario)
+        if target.suffix != ".toml" or not target.exists():   # a built-in scenario: write a copy
+            out.mkdir(parents=True, exist_ok=True)
+            target = out / f"{scenario.name}.toml"
+            if Path(scenario.source).is_file():
+                shutil.copyfile(scenario.source, target)
+            else:
+                from importlib import resources
+
+                target.write_text(resources.files("marinefmu").joinpath(f"data/scenarios/{scenario.name}.toml")
+                                  .read_text(encoding="utf-8"), encoding="utf-8")
+        # every controller of the system gets the gains: the comparison is of one controller fed
+        # different heave signals (truth, classical, observer)
+        names = [k.name for k in scenario.system.components if k.kind == "AhcController"]
+        for name in names:
+            write_gains(target, name, {g: round(float(getattr(c, g)), 6) for g in GAINS})
+        print(f"  gains written into {target} for {', '.join(names)}")
+    print(f"  design loop {total:.1f} s (identify {r.seconds['identify']:.1f}, tune {r.seconds['tune']:.1f}, "
+          f"verify {r.seconds['verify']:.1f}, plots {r.seconds['plots']:.1f})")
+    return 0
+
+
 def _cmd_example(args: argparse.Namespace) -> int:
     from .examples.registry import EXAMPLES, format_value
 
@@ -179,6 +250,19 @@ def main(argv: list[str] | None = None) -> int:
     k.add_argument("--memory-cycles", type=int, default=1000,
                    help="instantiate/free cycles per FMU of the memory measurement (default 1000; 0 skips it)")
     k.set_defaults(func=_cmd_bench)
+    a = sub.add_parser("design-ahc", help="heave-compensation design loop: identify the estimator in co-simulation, "
+                                          "tune the controller with python-control, verify, plot, write the gains")
+    a.add_argument("scenario", nargs="?", default="ahc", help="scenario TOML file or built-in name (default ahc)")
+    a.add_argument("--controller", help="the AhcController to design (default: the one fed by a HeaveObserver)")
+    a.add_argument("--identify", type=float, default=420.0, help="simulated time of the identification run [s] (default 420)")
+    a.add_argument("--verify", type=float, default=600.0, help="simulated time of the verification run [s] (default 600)")
+    a.add_argument("--phase-margin", type=float, default=60.0, help="phase margin of the length loop [deg] (default 60)")
+    a.add_argument("--out", default="results/ahc_design", help="folder for the plots (default results/ahc_design)")
+    a.add_argument("--fmus", help="folder holding the FMUs (default: build into the checkout's fmus/)")
+    a.add_argument("--write", action="store_true", help="write the gains into every AhcController of the scenario "
+                                                          "file (a built-in scenario: into a copy in --out)")
+    a.add_argument("--no-progress", action="store_true", help="no progress bars")
+    a.set_defaults(func=_cmd_design_ahc)
     e = sub.add_parser("example", help="run one of the papers' examples (list them with --list)")
     e.add_argument("name", nargs="?", help="example name, e.g. paper001-fig7")
     e.add_argument("--list", action="store_true", help="list the examples")

@@ -20,6 +20,23 @@ CentreOfRotation            ``cr_x_m``, ``cr_y_m``, ``cr_z_m`` (truth.cr, when t
                             the independent-rotation-centre mode and ``truth.cr.defined``)
 =========================  ====================================================================
 
+AhcWinch components (issue 9) are scored together, on one span: from ``settle`` s after the
+last AhcController of the system first reports ``valid`` (full compensation) to the end, so the
+winches of one run are compared on the same waves. Per winch: ``tip_heave_cm`` and
+``load_heave_cm``, the standard deviations of the crane tip (the source of the winch's
+``tip.d``) and of the load in the heave band, and ``residual_pct`` = 100 × their ratio;
+``tip_motion_cm``, ``load_motion_cm`` and ``residual_total_pct`` the same over all
+frequencies; ``limited_pct``, the percentage of steps with any limit flag set, and
+``speed_limited_pct``, ``acc_limited_pct``, ``stroke_limited_pct``, ``slack_pct`` per flag.
+**Heave** is the vertical motion at periods shorter than 2π/:data:`HEAVE_CUTOFF` = 31 s (wave
+periods at sea are 3-25 s; slower vertical motion, such as a drift of the attitude input times
+a lever arm, is not heave and is not what heave compensation is for), taken with a zero-phase
+4th-order Butterworth high pass (``scipy.signal.sosfiltfilt``: no phase error in the band).
+A winch whose controller is fed by a heave estimator (HeaveObserver, not ``model =
+"highpass"``) also gets ``vs_ideal`` and ``vs_classical``: its ``residual_pct`` over that of
+the winch fed by a VesselMotion's truth and of the one fed by the classical estimator
+(``model = "highpass"``), when the system has them.
+
 Every estimator also gets ``valid_fraction`` (of the whole run) and ``scored_s`` (the length of
 the span scored [s]). Other components, and metrics whose fields were not recorded, are left out.
 The estimator's lever arms must match the vessel's (a HeaveObserver's ``point`` is the vessel's
@@ -32,6 +49,11 @@ import math
 import numpy as np
 
 from .cosim.ssp import SystemDescription
+
+#: Lowest frequency of heave [rad/s] in the AHC scores (module docstring): periods up to 31 s.
+HEAVE_CUTOFF = 0.2
+#: The winch's limit flags, scored as percentages of time.
+LIMIT_FLAGS = ("speed_limited", "acc_limited", "stroke_limited", "slack")
 
 
 def _rms(e: np.ndarray) -> float:
@@ -111,7 +133,7 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
     out: dict[str, dict[str, float]] = {}
     for comp in system.components:
         kind = comp.kind
-        if f"{comp.name}.valid" not in fields or comp.name == vessel:
+        if f"{comp.name}.valid" not in fields or comp.name == vessel or kind == "AhcWinch":
             continue
         m = _span(result, comp.name, settle)
         m[:delay] = False
@@ -149,4 +171,89 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
             for a in "xyz":
                 row[f"cr_{a}_m"] = _rms(f(f"{c}.cr.{a}")[m] - f(f"{v}.truth.cr.{a}")[m])
         out[comp.name] = row
+    out.update(ahc_scores(result, system, settle))
+    return out
+
+
+def _source(system: SystemDescription, comp: str, var: str) -> tuple[str, str] | None:
+    """(component, variable) feeding input ``comp.var``, or None."""
+    for c in system.connections:
+        if c.end == comp and c.end_var == var:
+            return c.start, c.start_var
+    return None
+
+
+def _heave_band(x: np.ndarray, dt: float) -> np.ndarray:
+    """``x`` without its content below :data:`HEAVE_CUTOFF` (zero phase), about its mean."""
+    from scipy import signal
+
+    sos = signal.butter(4, HEAVE_CUTOFF, btype="highpass", fs=2.0 * math.pi / dt, output="sos")
+    return signal.sosfiltfilt(sos, x - x.mean())
+
+
+def ahc_scores(result: np.ndarray, system: SystemDescription, settle: float = 60.0) -> dict[str, dict[str, float]]:
+    """Metrics of every AhcWinch of ``system`` on one span (module docstring); {} without one.
+
+    Parameters
+    ----------
+    result : numpy.ndarray
+        Structured array of a run recording each winch's ``load.d`` and limit flags, the source
+        of its ``tip.d`` and the AhcControllers' ``valid``.
+    system : SystemDescription
+        The system that produced it.
+    settle : float
+        Time after the last controller first reports ``valid`` that is not scored [s].
+    """
+    fields = set(result.dtype.names)
+    kinds = {c.name: c for c in system.components}
+    winches = [c.name for c in system.components if c.kind == "AhcWinch" and f"{c.name}.load.d" in fields]
+    if not winches:
+        return {}
+    t = np.asarray(result["time"], dtype=float)
+    dt = t[1] - t[0]
+    start = t[0]
+    for c in system.components:
+        if c.kind == "AhcController" and f"{c.name}.valid" in fields:
+            valid = np.asarray(result[f"{c.name}.valid"], dtype=bool)
+            start = max(start, t[np.argmax(valid)] if valid.any() else math.inf)
+    span = t >= start + settle
+    if span.sum() < 10:
+        return {w: {"scored_s": 0.0} for w in winches}
+    out: dict[str, dict[str, float]] = {}
+    feeds: dict[str, str] = {}
+    for w in winches:
+        tip_src = _source(system, w, "tip.d")
+        load = np.asarray(result[f"{w}.load.d"], dtype=float)[span]
+        row: dict[str, float] = {"scored_s": float(span.sum() * dt)}
+        if tip_src is not None and ".".join(tip_src) in fields:
+            tip = np.asarray(result[".".join(tip_src)], dtype=float)[span]
+            row["tip_heave_cm"] = 100.0 * float(np.std(_heave_band(tip, dt)))
+            row["load_heave_cm"] = 100.0 * float(np.std(_heave_band(load, dt)))
+            row["residual_pct"] = 100.0 * row["load_heave_cm"] / row["tip_heave_cm"]
+            row["tip_motion_cm"] = 100.0 * float(np.std(tip))
+            row["load_motion_cm"] = 100.0 * float(np.std(load))
+            row["residual_total_pct"] = 100.0 * row["load_motion_cm"] / row["tip_motion_cm"]
+        flags = [n for n in LIMIT_FLAGS if f"{w}.{n}" in fields]
+        if flags:
+            hit = np.zeros(int(span.sum()), dtype=bool)
+            for n in flags:
+                x = np.asarray(result[f"{w}.{n}"], dtype=bool)[span]
+                row[f"{n}_pct"] = 100.0 * float(np.mean(x))
+                hit |= x
+            row["limited_pct"] = 100.0 * float(np.mean(hit))
+        ctrl = _source(system, w, "command")
+        heave = _source(system, ctrl[0], "heave") if ctrl and ctrl[0] in kinds else None
+        if heave is not None and heave[0] in kinds:
+            feeder = kinds[heave[0]]
+            if feeder.kind == "VesselMotion":
+                feeds[w] = "truth"
+            elif feeder.kind == "HeaveObserver":
+                feeds[w] = "classical" if feeder.parameters.get("model") == "highpass" else "observer"
+        out[w] = row
+    for w, feed in feeds.items():
+        if feed == "observer" and "residual_pct" in out[w]:
+            for other, key in (("truth", "vs_ideal"), ("classical", "vs_classical")):
+                ref = [out[o]["residual_pct"] for o, f in feeds.items() if f == other and "residual_pct" in out[o]]
+                if ref:
+                    out[w][key] = out[w]["residual_pct"] / ref[0]
     return out

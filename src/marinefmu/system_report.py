@@ -32,6 +32,12 @@ GOALS = {
     **{("GnssAccFusion", f"pos_{a}_cm"): ("≤ 0.5 × raw GNSS (issue 4)",
                                          lambda s, a=a: None if f"raw_gnss_{a}_cm" not in s else s[f"pos_{a}_cm"] <= 0.5 * s[f"raw_gnss_{a}_cm"])
        for a in "ned"},
+    # issue 9: the goals are for the loop fed by a heave estimator (the winch that has vs_ideal/vs_classical)
+    ("AhcWinch", "residual_pct"): ("≤ 5 % when fed by the observer (issue 9)",
+                                   lambda s: None if "vs_ideal" not in s and "vs_classical" not in s else s["residual_pct"] <= 5.0),
+    ("AhcWinch", "vs_ideal"): ("≤ 1.5 (issue 9)", lambda s: s["vs_ideal"] <= 1.5),
+    ("AhcWinch", "vs_classical"): ("< 1 (issue 9)", lambda s: s["vs_classical"] < 1.0),
+    ("AhcWinch", "limited_pct"): ("≤ 1 % (issue 9)", lambda s: s["limited_pct"] <= 1.0),
 }
 LABELS = {
     "roll_deg": "roll RMS error [deg]", "pitch_deg": "pitch RMS error [deg]",
@@ -45,6 +51,13 @@ LABELS = {
     "disp_n_cm": "COG north, centred estimate, RMS error [cm]", "disp_e_cm": "COG east, centred estimate, RMS error [cm]",
     "disp_d_cm": "COG down, centred estimate, RMS error [cm]",
     "valid_fraction": "fraction of the run with valid output", "scored_s": "time scored [s]",
+    "tip_heave_cm": "crane-tip heave std [cm]", "load_heave_cm": "load heave std [cm]",
+    "residual_pct": "load heave / tip heave [%]", "tip_motion_cm": "crane-tip vertical motion std, all frequencies [cm]",
+    "load_motion_cm": "load vertical motion std, all frequencies [cm]",
+    "residual_total_pct": "load / tip vertical motion, all frequencies [%]",
+    "vs_ideal": "residual / residual of the truth-fed loop", "vs_classical": "residual / residual of the classical-fed loop",
+    "limited_pct": "time with a winch limit acting [%]",
+    **{f"{n}_pct": f"time {n.replace('_', ' ')} [%]" for n in ("speed_limited", "acc_limited", "stroke_limited", "slack")},
 }
 
 
@@ -192,6 +205,18 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
                 ax.legend(loc="upper right", ncol=3, fontsize=8)
                 out.append((f"{c}: COG displacement reconstructed from acceleration alone (no GNSS), centred "
                             f"window estimate, {delay:g} s behind real time", _png(fig)))
+    winches = [c.name for c in system.components if c.kind == "AhcWinch" and f"{c.name}.load.d" in fields]
+    tip = f"{vessel}.truth.point.d"
+    if winches and tip in fields:
+        fig, ax = plt.subplots(figsize=(10, 3.8))
+        ax.plot(t[last], -(g(tip)[last] - g(tip)[last].mean()), "k", lw=2, alpha=0.4, label="crane tip")
+        for w in winches:
+            load = g(f"{w}.load.d")[last]
+            ax.plot(t[last], -(load - load.mean()), lw=0.9, label=f"load, {w}")
+        ax.set_ylabel("vertical motion about the mean [m, up]")
+        ax.set_xlabel("time [s]")
+        ax.legend(loc="upper right", ncol=3, fontsize=8)
+        out.append(("heave compensation: the crane tip and each winch's load, the last minute", _png(fig)))
     return out
 
 
