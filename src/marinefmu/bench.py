@@ -13,7 +13,9 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 Then (``parts``): the paper 003 heave accuracy over five seas (:func:`heave_accuracy`),
 marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
 (``orcaflex``), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
-seas, speed under FMPy, in-process and libcosim, memory of a 3-hour run), and the memory of
+seas, speed under FMPy, in-process and libcosim, memory of a 3-hour run), the heave
+compensation's design loop and four-way comparison (``ahc``, :mod:`marinefmu.bench_ahc`), and
+the memory of
 every FMU over 10⁶ steps and over 1,000 instantiate/free cycles (:mod:`marinefmu.bench_memory`,
 issue 8).
 """
@@ -141,7 +143,7 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
 
 
 #: Parts of ``marinefmu bench``, in the order they run.
-PARTS = ("speed", "heave", "peer", "orcaflex", "system", "memory")
+PARTS = ("speed", "heave", "peer", "orcaflex", "system", "ahc", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks: Hs [m], Tp [s]).
@@ -271,6 +273,10 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             from .bench_system import whole_system
 
             data["system"] = {**stamp, **whole_system(fmu_dir, out_dir / "system_runs")}
+        elif part == "ahc":
+            from .bench_ahc import ahc_bench
+
+            data["ahc"] = {**stamp, **ahc_bench(fmu_dir, out_dir)}
         else:
             data["memory"] = {**stamp, "steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0,
                               "fmus": memory(fmu_dir, memory_steps, memory_cycles)}
