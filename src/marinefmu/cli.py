@@ -89,7 +89,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         print(f"  summary of {comp}:")
         for k, v in vessel_summary(result, comp).items():
             print(f"    {k:28s} {v:.6g}")
-    vessels = vessel_components(result)
+    # the truth comes from the system's VesselMotion, whatever of it was recorded (plots need more)
+    vessels = [c.name for c in scenario.system.components if c.kind == "VesselMotion"] or vessel_components(result)
     scores = {}
     if vessels:
         from .scoring import score
