@@ -38,7 +38,8 @@ FMUS = ("VesselMotion", "AttitudeEstimator", "DisplacementReconstructor", "GnssA
 #: Inputs with no VesselMotion output of their name: (source output, offset added)
 ALIASES = {"tip.n": ("truth.point.n", 0.0), "tip.e": ("truth.point.e", 0.0), "tip.d": ("truth.point.d", 0.0),
            "tip_vel.d": ("truth.point_vel.d", 0.0), "command": ("truth.point_vel.d", 0.0),
-           "heave": ("truth.point.d", 10.0), "heave_rate": ("truth.point_vel.d", 0.0), "length": ("truth.point.d", 30.0)}
+           "heave": ("truth.point.d", 10.0), "heave_rate": ("truth.point_vel.d", 0.0), "length": ("truth.point.d", 30.0),
+           "heave_valid": ("gnss.valid", 0.0)}   # a boolean input (true through the record)
 VESSEL = {"sea.hs": 2.5, "sea.tp": 8.0, "gnss.rate": 5.0, "imu.x": 5.0, "imu.z": -3.0}
 #: Parameters of each FMU for these cases: short windows so every estimator is valid within 70 s.
 PARAMS = {
@@ -53,7 +54,8 @@ PARAMS = {
 }
 #: Steps until each FMU's outputs are valid with PARAMS (checked by the ``state`` case).
 WARM_UP = {"VesselMotion": 1, "AttitudeEstimator": 100, "DisplacementReconstructor": 1500, "GnssAccFusion": 200,
-           "CentreOfRotation": 200, "HeaveObserver": 1300, "AhcWinch": 1, "AhcController": 1}
+           "CentreOfRotation": 200, "HeaveObserver": 1300, "AhcWinch": 1,
+           "AhcController": 201}   # the feedforward fades in over engage_time = 10 s before valid
 #: A refused parameter per FMU (logging-off case).
 BAD_PARAMETER = {"VesselMotion": ("sea.hs", -1.0), "AttitudeEstimator": ("vel_sigma", -1.0),
                  "DisplacementReconstructor": ("window", 10.0), "GnssAccFusion": ("gate", 0.0),
