@@ -3,8 +3,6 @@ scenario ``ahc`` (VesselMotion → AttitudeEstimator → HeaveObserver → AhcCo
 beside the truth-fed, classical-fed and uncompensated winches) against the issue's goals, the
 design loop (identify, tune, verify, write), and the same system under FMPy, in-process and
 OSP libcosim."""
-import math
-import shutil
 import subprocess
 import sys
 import tomllib

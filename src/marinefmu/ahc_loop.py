@@ -23,7 +23,6 @@ here, naming what is missing.
 """
 from __future__ import annotations
 
-import math
 import re
 import time
 from dataclasses import dataclass, replace
