@@ -267,6 +267,18 @@ def central_rate(prev: tuple[float, float], nxt: tuple[float, float], dt: float)
     return (nxt[0] - prev[0]) / (2 * dt), (nxt[1] - prev[1]) / (2 * dt)
 
 
+def read_sample(acc: Any, roll: float, pitch: float) -> tuple[np.ndarray, float, float, str | None]:
+    """One IMU sample as the heave estimators take it: (f_b (3,) [m/s²], roll, pitch [rad],
+    the reason it is bad or None). ``acc`` is f_z or (3,) f_b; another shape is a bad sample."""
+    f = np.asarray(acc, dtype=float).reshape(-1)
+    if f.shape == (1,):
+        f = np.array([0.0, 0.0, f[0]])
+    elif f.shape != (3,):
+        f = np.full(3, math.nan)
+    roll, pitch = float(roll), float(pitch)
+    return f, roll, pitch, _bad_sample(f, roll, pitch)
+
+
 def _bad_sample(acc: np.ndarray, roll: float, pitch: float) -> str | None:
     if not (np.all(np.isfinite(acc)) and math.isfinite(roll) and math.isfinite(pitch)):
         return "non-finite acceleration or angle sample"
@@ -405,13 +417,7 @@ class HeaveObserver:
             says why.
         """
         p = self.params
-        f = np.asarray(acc, dtype=float).reshape(-1)
-        if f.shape == (1,):
-            f = np.array([0.0, 0.0, f[0]])
-        elif f.shape != (3,):
-            f = np.full(3, math.nan)
-        roll, pitch = float(roll), float(pitch)
-        warning = _bad_sample(f, roll, pitch)
+        f, roll, pitch, warning = read_sample(acc, roll, pitch)
         if warning is not None:
             self.log.warning("heave observer: %s; coasting on the model", warning)
         restarted = None

@@ -22,13 +22,12 @@ while the start from rest decays. The outputs have the observer's shape
 from __future__ import annotations
 
 import logging
-import math
 from typing import Any
 
 import numpy as np
 from scipy import signal
 
-from .heave import HeaveObserver, HeaveObserverParams, HeaveResult, _bad_sample, _Silent, backward_rate, point_heave, \
+from .heave import HeaveObserver, HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, read_sample, \
     vertical_acceleration
 from .integration import highpass_sections
 
@@ -93,13 +92,7 @@ class HighpassHeave:
     def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
         """Process one sample (arguments as :meth:`.HeaveObserver.step`)."""
         p = self.params
-        f = np.asarray(acc, dtype=float).reshape(-1)
-        if f.shape == (1,):
-            f = np.array([0.0, 0.0, f[0]])
-        elif f.shape != (3,):
-            f = np.full(3, math.nan)
-        roll, pitch = float(roll), float(pitch)
-        warning = _bad_sample(f, roll, pitch)
+        f, roll, pitch, warning = read_sample(acc, roll, pitch)
         if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
             warning = f"step size changed from {self.dt} s to {dt} s; filter restarted"
             self.reset()
