@@ -208,3 +208,15 @@ def test_the_copyable_example_designs_and_writes(tmp_path, fmu_dir):
     r = example.main(["--identify", "300", "--verify", "0", "--out", str(tmp_path)])
     assert r["margin"] in (45.0, 60.0, 75.0) and 0.3 < r["predicted_pct"] < 5.0 and r["measured"] == {}
     assert load_scenario(r["file"]).system.component("ctrl_observer").parameters["k_ff"] == round(r["controller"].k_ff, 6)
+
+
+def test_design_ahc_refuses_a_bad_request_before_running_anything(tmp_path, capsys):
+    from marinefmu.cli import main
+
+    args = ["design-ahc", "ahc", "--fmus", str(tmp_path), "--out", str(tmp_path)]
+    assert main(args + ["--controller", "att"]) == 2
+    assert "'att' is not an AhcController of system 'ahc'" in capsys.readouterr().err
+    assert main(args + ["--identify", "10"]) == 2
+    assert "identify_s = 10.0 is out of range" in capsys.readouterr().err
+    assert main(args + ["--phase-margin", "95"]) == 2
+    assert "phase_margin = 95.0 is out of range" in capsys.readouterr().err

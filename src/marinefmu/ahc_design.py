@@ -294,6 +294,11 @@ def _loop(plant, kp: float, wc: float):
     return control.tf([kp, kp * wc / 10.0], [1.0, 0.0]) * plant
 
 
+def check_phase_margin(phase_margin: float) -> float:
+    """``phase_margin`` [deg] if in (0, 90), else :class:`~.errors.ParameterError` naming it."""
+    return check_range("phase_margin", phase_margin, lo=0.0, hi=90.0, lo_open=True, hi_open=True, unit="deg")
+
+
 def design(winch: WinchParams | None = None, phase_margin: float = 60.0) -> AhcDesign:
     """Tune the PI length loop for ``winch`` (module docstring).
 
@@ -306,7 +311,7 @@ def design(winch: WinchParams | None = None, phase_margin: float = 60.0) -> AhcD
     import control
 
     winch = winch or WinchParams()
-    check_range("phase_margin", phase_margin, lo=0.0, hi=90.0, lo_open=True, hi_open=True, unit="deg")
+    check_phase_margin(phase_margin)
     plant = winch_tf(winch)
     w_load = math.sqrt(winch.stiffness / winch.mass)
     best = None

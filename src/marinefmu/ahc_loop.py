@@ -32,7 +32,7 @@ import numpy as np
 
 from .ahc.controller import ControllerParams
 from .ahc.winch import WinchParams
-from .ahc_design import AhcDesign, EstimatorResponse, design, fit_feedforward, identify_response, load_tf, \
+from .ahc_design import AhcDesign, EstimatorResponse, check_phase_margin, design, fit_feedforward, identify_response, load_tf, \
     predicted_residual, residual_response, winch_tf
 from .cosim.ahc_io import controller_params, winch_params
 from .cosim.ssp import SystemDescription
@@ -325,6 +325,7 @@ def design_loop(scenario: Scenario, controller: str, fmu_dir: str | Path, out_di
     """
     check_range("identify_s", identify_s, lo=60.0, hi=1e5, unit="s")
     check_range("verify_s", verify_s, lo=60.0, hi=1e5, unit="s")
+    check_phase_margin(phase_margin)                 # refused before anything runs
     system = scenario.system
     parts = find_loop(system, controller)
     comps = {c.name: c for c in system.components}
