@@ -33,6 +33,39 @@ def relay_fmu(tmp_path_factory) -> Path:
 DT = 0.01
 
 
+class LibcosimBeside:
+    """A built-in scenario run by OSP libcosim (``run_libcosim``) in a second process, while the
+    test runs its own engine in this one; a context manager that kills the process on exit.
+
+    ``result(timeout)`` waits for it, checks it ended well and returns its structured array
+    (``record`` sampled every ``sample`` s from ``sample`` on)."""
+
+    def __init__(self, scenario, fmu_dir, work, duration, record, sample):
+        import subprocess
+        import sys
+
+        self.out = Path(work) / "libcosim.npy"
+        code = ("import os, numpy as np\nfrom marinefmu.scenarios import load_scenario\n"
+                "from marinefmu.cosim.libcosim_runner import run_libcosim\n"
+                f"out = run_libcosim(load_scenario({scenario!r}).system, {str(fmu_dir)!r}, {str(work)!r}, {duration}, "
+                f"{list(record)!r}, {sample})\nnp.save({str(self.out)!r}, out)\nos._exit(0)\n")
+        self.proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.proc.kill()
+
+    def result(self, timeout):
+        import numpy as np
+
+        _, err = self.proc.communicate(timeout=timeout)
+        assert self.proc.returncode == 0, err[-3000:]
+        return np.load(self.out)
+
+
 class Driver:
     """One FMU instance driven step by step through FMPy's FMU2Slave (DT = 0.01 s)."""
 

@@ -3,13 +3,12 @@ scenario ``ahc`` (VesselMotion → AttitudeEstimator → HeaveObserver → AhcCo
 beside the truth-fed, classical-fed and uncompensated winches) against the issue's goals, the
 design loop (identify, tune, verify, write), and the same system under FMPy, in-process and
 OSP libcosim."""
-import subprocess
-import sys
 import tomllib
 from dataclasses import replace
 
 import numpy as np
 import pytest
+from conftest import LibcosimBeside
 
 from marinefmu.ahc.winch import WinchParams
 from marinefmu.ahc_design import design, fit_feedforward, identify_response, predicted_residual
@@ -172,23 +171,14 @@ def test_the_ahc_system_is_the_same_under_fmpy_in_process_and_libcosim(fmu_dir, 
     sc = load_scenario("ahc")
     duration, sample = 150.0, 1.0
     record = list(sc.record)
-    code = ("import os, numpy as np\nfrom marinefmu.scenarios import load_scenario\n"
-            "from marinefmu.cosim.libcosim_runner import run_libcosim\n"
-            f"out = run_libcosim(load_scenario('ahc').system, {str(fmu_dir)!r}, {str(tmp_path)!r}, {duration}, "
-            f"{record!r}, {sample})\nnp.save({str(tmp_path / 'libcosim.npy')!r}, out)\nos._exit(0)\n")
-    libcosim = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
+    with LibcosimBeside("ahc", fmu_dir, tmp_path, duration, record, sample) as libcosim:
         fmpy = SystemRunner(sc.system, fmu_dir).run(duration, record=record, progress=False)
         python = SystemRunner(sc.system, fmu_dir, engine="python").run(duration, record=record, progress=False)
-        _, err = libcosim.communicate(timeout=500)
-    finally:
-        libcosim.kill()
-    assert libcosim.returncode == 0, err[-3000:]
+        lib = libcosim.result(timeout=500)
     for f in record:
         np.testing.assert_array_equal(python[f], fmpy[f], err_msg=f)
     assert fmpy["ctrl_observer.engagement"][-1] == 1.0 and abs(fmpy["winch_observer.speed"]).max() > 0.3
     every = int(round(sample / sc.step))
-    lib = np.load(tmp_path / "libcosim.npy")
     for f in record:
         np.testing.assert_allclose(lib[f].astype(float), fmpy[every::every][f].astype(float), rtol=1e-9,
                                    atol=1e-9 if f.endswith(".acc") else 1e-12, err_msg=f)

@@ -2,11 +2,9 @@
 (VesselMotion → AttitudeEstimator → DisplacementReconstructor, GnssAccFusion, CentreOfRotation,
 HeaveObserver) written as an SSP package and run by the FMPy runner from it, and written as an
 ``OspSystemStructure.xml`` and run by OSP libcosim; 10 simulated minutes, the same outputs."""
-import subprocess
-import sys
-
 import numpy as np
 import pytest
+from conftest import LibcosimBeside
 
 from marinefmu.cosim.libcosim_runner import write_osp_system
 from marinefmu.cosim.ssp import read_ssp, write_ssp
@@ -63,21 +61,12 @@ def test_whole_system_runs_the_same_under_fmpy_and_libcosim(fmu_dir, tmp_path):
     60 s), sampled every 10 s over 10 minutes. The FMPy side runs from the unpacked SSP, the
     libcosim side (in a second process, at the same time) from the OSP file."""
     sc = load_scenario("system")
-    code = ("import os, numpy as np\nfrom marinefmu.scenarios import load_scenario\n"
-            "from marinefmu.cosim.libcosim_runner import run_libcosim\n"
-            f"out = run_libcosim(load_scenario('system').system, {str(fmu_dir)!r}, {str(tmp_path)!r}, {DURATION}, "
-            f"{RECORD!r}, {SAMPLE})\nnp.save({str(tmp_path / 'libcosim.npy')!r}, out)\nos._exit(0)\n")
-    libcosim = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
+    with LibcosimBeside("system", fmu_dir, tmp_path, DURATION, RECORD, SAMPLE) as libcosim:
         system = read_ssp(write_ssp(sc.system, fmu_dir, tmp_path / "system.ssp"), tmp_path / "ssp")
         full = SystemRunner(system).run(DURATION, record=RECORD, progress=False)
-        _, err = libcosim.communicate(timeout=800)
-    finally:
-        libcosim.kill()
-    assert libcosim.returncode == 0, err[-3000:]
+        lib = libcosim.result(timeout=800)
     every = int(round(SAMPLE / sc.step))
     fmpy = full[every::every]
-    lib = np.load(tmp_path / "libcosim.npy")
     np.testing.assert_allclose(lib["time"], fmpy["time"], rtol=0, atol=1e-9)
     for f in RECORD:
         np.testing.assert_allclose(lib[f].astype(float), fmpy[f].astype(float), rtol=1e-9, atol=1e-12, err_msg=f)
