@@ -178,13 +178,13 @@ def test_a_20_m_jump_is_gated_out():
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
-    """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 120 s window and 120 s of
-    anchors before it). Real time with ``coast="band"`` (default): measured max per axis
-    1.8-4.3 / 3.8-11.2 / 3.9-6.0 cm north / east / down over seeds 1-3 (east: the band observer's
-    response on the sway, README), against metres for the inertial coast (README); bound 12 cm per axis.
-    RTS-smoothed through the gap: measured max 1.3-3.0 / 3.4-9.1 / 3.2-4.6 cm, so the 10 cm
-    goal holds on every axis (bound 10 cm). Back within 5 cm (3-D) 5 s after the fixes
-    return, and valid throughout (within max_coast)."""
+    """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 120 s window and 180 s of
+    fixes before it). Real time with ``coast="band"`` (default, the GNSS-aided band observer of
+    estimators.aided_band): measured max per axis 1.9-4.3 / 4.7-8.4 / 3.0-5.4 cm north / east /
+    down over seeds 1-3 (the line coast before it: east 8.4 / 3.8 / 11.2 cm), against metres for
+    the inertial coast (README). The goal, 10 cm per axis, is the bound. RTS-smoothed through
+    the gap: measured max 1.4-2.7 / 3.3-6.4 / 2.0-4.0 cm (bound 10 cm). Back within 5 cm (3-D)
+    5 s after the fixes return, and valid throughout (within max_coast)."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
                                     "sea.seed": seed, "sensors.seed": seed})
     r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(),
@@ -193,7 +193,7 @@ def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     gap = slice(k, k + 3000)
     assert np.all(np.isfinite(r["pos"])) and np.all(r["valid"][gap])
     assert np.sum(r["fix"][gap] == "wave") >= 279   # a pseudo-fix every 0.1 s from 2 s into the gap
-    assert np.all(np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0) < 0.12)
+    assert np.all(np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0) < 0.10)
     assert np.all(np.max(np.abs(r["pos_smooth"][gap] - rec["cog"][gap]), axis=0) < 0.10)
     after = slice(int(335.0 / paper001.DT), None)
     assert np.max(np.linalg.norm(r["pos"][after] - rec["cog"][after], axis=1)) < 0.05
@@ -225,7 +225,8 @@ def test_wave_coast_recovers_a_moving_wave_record():
     """Synthetic: a vessel drifting at 0.1 m/s north with 0.5 m / 10 s waves on each axis
     (different phases) and a 2e-3 m/s² accelerometer offset. With GNSS anchors every second
     for the first 300 s, the coast position through the next 30 s stays within 2 cm of
-    truth (measured 0.6 cm: the offset state takes the bias, the line the drift)."""
+    truth (measured 0.5 / 0.5 / 0.2 cm N / E / D: the offset state takes the bias, the drift
+    states the 0.1 m/s; 0.6 cm with the line coast before)."""
     dt, w = 0.05, 2 * math.pi / 10.0
     t = np.arange(1, int(330 / dt) + 1) * dt
     phase = np.array([0.0, 1.0, 2.0])

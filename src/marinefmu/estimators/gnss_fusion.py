@@ -484,7 +484,7 @@ class GnssAccFusion:
     def _initialise(self, sol: AntennaFix, z: np.ndarray, r_meas: np.ndarray) -> None:
         p = self.params
         if self.coaster is not None:
-            self.coaster.clear_anchors()
+            self.coaster.forget_position()
         nx = self.kf.dim_x
         self.prior = None  # a restart: nothing to smooth across
         self.kf.x = np.zeros((nx, 1))

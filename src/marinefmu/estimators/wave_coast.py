@@ -11,61 +11,71 @@ Method, per NED axis:
 
 1. a band observer — :class:`~.heave.HeaveObserver` with ``model="band"``, the heave observer of
    paper 003, run on one axis of the attitude-corrected acceleration a_n at the accelerometer,
-   decimated to about :data:`RATE` Hz by block means — gives the wave-frequency displacement
-   d_w(t) and its rate, with no content below the sea's band (its offset state takes the rest);
-2. at every accepted GNSS fix z (the accelerometer point), z − d_w is an *anchor* of the
-   low-frequency position;
-3. a straight line fitted to the anchors of the last ``window`` seconds (numpy ``polyfit``)
-   extrapolates the low-frequency position, and the coast position is line(t) + d_w(t).
+   decimated to about :data:`RATE` Hz by block means — measures the sea's spectrum along the
+   axis and builds the model of its wave-frequency motion (band elements and an offset);
+2. :class:`~.aided_band.AidedBand` runs that model in one Kalman filter with a
+   constant-velocity drift, updated by the acceleration at every band step and by every
+   accepted GNSS fix z of the accelerometer point, so the fixes anchor the wave states as well
+   as the drift;
+3. in a gap the filter goes on with the acceleration alone: the coast position is its
+   Σ elements + drift.
 
-Its error is the band observer's wave-frequency error plus the line's extrapolation error: a
-vessel that manoeuvres during the gap breaks the assumption (use ``coast="inertial"`` in
-:class:`~.gnss_fusion.FusionParams` then). :class:`~.gnss_fusion.GnssAccFusion` feeds the
-coast position to its Kalman filter as a pseudo-fix every 0.1 s while GNSS is missing.
+Until 2026-11-22 step 2 was the band observer alone plus a straight line fitted to the anchors
+z − d_w of the last ``window`` s; its wave displacement d_w carried g × the antenna-attitude
+error at 0.1-0.3 rad/s (3.5 cm RMS east before the gap on the paper-001 set-up), which the
+fixes now remove (:mod:`.aided_band`, with the figures). The error left is the band
+observer's acceleration-only response through the gap. A vessel that manoeuvres during the gap
+breaks the drift assumption: use ``coast="inertial"`` in :class:`~.gnss_fusion.FusionParams`
+then. :class:`~.gnss_fusion.GnssAccFusion` feeds the coast position to its Kalman filter as a
+pseudo-fix every 0.1 s while GNSS is missing.
 
 The horizontal observers use ``offset_noise`` :data:`HORIZONTAL_OFFSET_NOISE`, ten times the
 heave default: the horizontal a_n carries g × the attitude error of the antenna fixes (about
-5 mm/s² RMS at 0.1-0.25 rad/s with 1 cm fixes on an 8 m baseline), which a weaker offset
-leaves to the lowest band elements as displacement (measured: 25 cm RMS east instead of
-3-5 cm).
+5 mm/s² RMS at 0.1-0.25 rad/s with 1 cm fixes on an 8 m baseline) and, in a gap, g × the
+gyro-propagated tilt drift, which a weaker offset leaves to the lowest band elements as
+displacement (with the aided filter, seeds 1 / 3 / 4 / 9, max east error through the dropout:
+1e-4: 11.5 / 22.5 / 10.2 / 27.7 cm; 3e-4: 9.6 / 14.9 / 6.6 / 13.9 cm; 1e-3: 8.4 / 8.4 / 9.7 /
+9.1 cm; 3e-3: 8.3 / 10.5 / 12.4 / 12.5 cm).
 """
 from __future__ import annotations
 
 import math
-from collections import deque
 
 import numpy as np
 
 from ..frames import G
+from .aided_band import AidedBand, drift_noise
 from .heave import HeaveObserver, HeaveObserverParams
 
 #: Target rate of the band observers [Hz] (block means of the accelerometer samples).
 RATE = 20.0
 #: Offset-state random-walk density of the north and east observers [m/s²/√s] (module docstring).
 HORIZONTAL_OFFSET_NOISE = 1e-3
-#: Fewest anchors for a line.
+#: Fewest fixes before the coast gives a position.
 MIN_ANCHORS = 3
 #: Time between the band observers' spectrum updates [s]. The sea state changes over tens of
 #: minutes; the heave observer's 15 s (paper 003) here cost 60 % of the fusion's time (three
 #: 217-state steady-state filters rebuilt with ``dlqe``) for no better coast: the 30 s dropout
 #: of the paper-001 set-up erred at most 7.0 / 4.9 / 11.5 cm east over seeds 1-3 with 15 s,
-#: 8.4 / 3.8 / 11.2 cm with 60 s, and the fusion ran 2.3 times faster.
+#: 8.4 / 3.8 / 11.2 cm with 60 s, and the fusion ran 2.3 times faster (measured with the line
+#: coast, before :mod:`.aided_band`).
 PEAK_INTERVAL = 60.0
 
 
 class WaveCoast:
-    """Low-frequency line plus wave-frequency band displacement, per NED axis (module docstring).
+    """Wave-frequency motion plus drift per NED axis, aided by GNSS (module docstring).
 
     Parameters
     ----------
     window : float
-        Anchors older than this [s] are dropped from the line fit, > 0.
+        Memory of the drift model [s] (:func:`~.aided_band.drift_noise`), and the longest time
+        without a fix after which the coast gives no position, > 0.
 
     Examples
     --------
     >>> c = WaveCoast(120.0)
     >>> c.add(np.zeros(3), 0.01)
-    >>> c.position() is None        # no band observer output and no anchors yet
+    >>> c.position() is None        # no band model and no fixes yet
     True
     """
 
@@ -74,7 +84,7 @@ class WaveCoast:
         self.reset()
 
     def reset(self) -> None:
-        """Forget everything (observers, block, anchors)."""
+        """Forget everything (observers, block, filters)."""
         horizontal = HeaveObserverParams(offset_noise=HORIZONTAL_OFFSET_NOISE, smoother_lag=0.0,
                                          peak_interval=PEAK_INTERVAL)
         self.observers = [HeaveObserver(horizontal, quiet=True), HeaveObserver(horizontal, quiet=True),
@@ -84,10 +94,9 @@ class WaveCoast:
         self.k = 0                          # accelerometer samples seen (time = k·dt)
         self.acc_sum = np.zeros(3)          # a_n summed over the current block
         self.in_block = 0
-        self.disp: np.ndarray | None = None  # d_w at the end of the last block [m], NED
-        self.rate = np.zeros(3)              # its rate [m/s]
-        self.k_disp = 0                      # sample count at the end of the last block
-        self.anchors: deque[tuple[int, tuple[float, float, float]]] = deque()
+        self.bands: list[AidedBand] = []    # per axis, from the first sample on
+        self.k_band = 0                     # sample count at the end of the last block
+        self.k_fix: int | None = None       # sample count of the last fix
 
     def add(self, acc_n: np.ndarray, dt: float) -> None:
         """Take one attitude-corrected acceleration sample a_n [m/s², NED, gravity removed]
@@ -95,8 +104,7 @@ class WaveCoast:
         if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
             self.reset()
         if self.dt is None:
-            self.dt = float(dt)
-            self.block = max(1, int(round(1.0 / (RATE * dt))))
+            self._start(dt)
         self.k += 1
         self.acc_sum += acc_n
         self.in_block += 1
@@ -105,69 +113,77 @@ class WaveCoast:
         mean = self.acc_sum / self.block
         self.acc_sum[:] = 0.0
         self.in_block = 0
-        # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g
-        res = [obs.step(float(a) - G, 0.0, 0.0, self.block * self.dt) for obs, a in zip(self.observers, mean)]
-        if self.k * self.dt < self.observers[0].params.window:
-            return                              # no spectrum yet
-        # an axis whose spectrum had no band energy (no waves along it) has no wave motion
-        self.disp = np.array([r.heave if r.valid else 0.0 for r in res])
-        self.rate = np.array([r.heave_rate if r.valid else 0.0 for r in res])
-        self.k_disp = self.k
+        for obs, band, a in zip(self.observers, self.bands, mean):
+            # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g
+            obs.step(float(a) - G, 0.0, 0.0, self.block * self.dt)
+            if obs.model is not None and obs.model is not band.model:
+                band.follow(obs.model, obs.xp)
+            band.accelerate(float(a))
+        self.k_band = self.k
 
-    def displacement(self) -> np.ndarray | None:
-        """d_w now [m, NED] (the last block's value moved on by its rate), or None before the
-        band observers have their first spectrum."""
-        if self.disp is None:
-            return None
-        return self.disp + self.rate * ((self.k - self.k_disp) * self.dt)
+    def _start(self, dt: float) -> None:
+        self.dt = float(dt)
+        self.block = max(1, int(round(1.0 / (RATE * dt))))
+        self.bands = [AidedBand(drift_noise(self.window), self.block * self.dt) for _ in range(3)]
+
+    @property
+    def ready(self) -> bool:
+        """The band observers have had their first spectrum (an axis without band energy has
+        no wave model and only the drift)."""
+        return self.dt is not None and self.k * self.dt >= self.observers[0].params.window
+
+    def _lead(self) -> float:
+        """Time since the end of the last block [s]."""
+        return (self.k - self.k_band) * self.dt
 
     def anchor(self, z: np.ndarray) -> None:
-        """Record an accepted GNSS position of the accelerometer point z [m, NED]."""
-        d = self.displacement()
-        if d is None:
+        """Update with an accepted GNSS position of the accelerometer point z [m, NED]
+        (ignored before the first spectrum: the drift would take the waves)."""
+        if not self.ready:
             return
-        self.anchors.append((self.k, tuple((np.asarray(z, dtype=float) - d).tolist())))
-        oldest = self.k - self.window / self.dt
-        while self.anchors and self.anchors[0][0] < oldest:
-            self.anchors.popleft()
+        lead = self._lead()
+        for band, zi in zip(self.bands, np.asarray(z, dtype=float)):
+            band.fix(float(zi), lead)
+        self.k_fix = self.k
 
-    def clear_anchors(self) -> None:
-        """Drop the anchors (the filter re-initialised: a real reposition)."""
-        self.anchors.clear()
+    def forget_position(self) -> None:
+        """Forget the drift (the fusion re-initialised: a real reposition)."""
+        for band in self.bands:
+            band.restart_drift()
+        self.k_fix = None
 
     def position(self) -> np.ndarray | None:
-        """Coast position of the accelerometer point now [m, NED], or None if the band
-        observers are not ready or fewer than :data:`MIN_ANCHORS` anchors span the window."""
-        d = self.displacement()
-        if d is None or len(self.anchors) < MIN_ANCHORS:
+        """Coast position of the accelerometer point now [m, NED], or None before the first
+        spectrum, before :data:`MIN_ANCHORS` fixes, or ``window`` s after the last fix."""
+        if (not self.ready or self.k_fix is None or (self.k - self.k_fix) * self.dt > self.window
+                or min(b.fixes for b in self.bands) < MIN_ANCHORS):
             return None
-        t = np.array([a[0] for a in self.anchors], dtype=float) - self.k
-        y = np.array([a[1] for a in self.anchors])
-        level = np.polyfit(t, y, 1)[1]           # per axis, at t = 0 (now)
-        return level + d
+        lead = self._lead()
+        return np.array([b.position(lead) for b in self.bands])
 
     # ---- state ------------------------------------------------------------------------------
     def get_state(self) -> dict:
         """JSON-serialisable state."""
         return {
             "dt": self.dt, "block": self.block, "k": self.k, "acc_sum": self.acc_sum.tolist(),
-            "in_block": self.in_block, "disp": None if self.disp is None else self.disp.tolist(),
-            "rate": self.rate.tolist(), "k_disp": self.k_disp,
-            "anchors": [[k, list(a)] for k, a in self.anchors],
+            "in_block": self.in_block, "k_band": self.k_band, "k_fix": self.k_fix,
             "observers": [o.get_state() for o in self.observers],
+            "bands": [b.get_state() for b in self.bands],
         }
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
         self.reset()
-        self.dt = None if s["dt"] is None else float(s["dt"])
-        self.block, self.k, self.in_block, self.k_disp = int(s["block"]), int(s["k"]), int(s["in_block"]), int(s["k_disp"])
+        if s["dt"] is None:
+            return
+        self._start(float(s["dt"]))
+        self.block, self.k, self.in_block, self.k_band = int(s["block"]), int(s["k"]), int(s["in_block"]), int(s["k_band"])
+        self.k_fix = None if s["k_fix"] is None else int(s["k_fix"])
         self.acc_sum = np.array(s["acc_sum"], dtype=float)
-        self.disp = None if s["disp"] is None else np.array(s["disp"], dtype=float)
-        self.rate = np.array(s["rate"], dtype=float)
-        self.anchors = deque((int(k), tuple(a)) for k, a in s["anchors"])
         for o, st in zip(self.observers, s["observers"]):
             o.set_state(st)
+        for b, o, st in zip(self.bands, self.observers, s["bands"]):
+            b.set_state(st, o.model)
 
 
 def coast_floor(sigma_b: float, tau: float, duration: float, dt: float = 0.1, runs: int = 400,

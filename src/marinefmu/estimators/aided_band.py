@@ -1,0 +1,240 @@
+"""GNSS-aided band observer of one NED axis: the wave model of a GNSS dropout coast (beyond
+papers 001 and 003).
+
+Why. The coast of :mod:`.wave_coast` used to run the band observer of paper 003 on the
+acceleration alone and add a straight line fitted to the GNSS anchors z − d_w. That observer's
+wave displacement d_w was then only as good as the accelerometer makes it, all the time: on the
+paper-001 set-up its east error was 3.5 cm RMS (8 cm max) on a 57 cm sway *before* any gap,
+mostly from g × the antenna-attitude error at 0.1-0.3 rad/s, which the accelerometer cannot
+tell from sway. GNSS sees that displacement, but a line through the anchors could not give it
+back to the wave states. Applying the fixes to the band observer with its acceleration-only
+steady-state covariance did not work either (worse: the gain was wrong once positions are
+measured). The states need one covariance that knows both measurement types.
+
+Model. One Kalman filter with the state
+
+    x = [band elements …, offset, drift position p_d, drift velocity v_d]
+
+* the band elements and the offset are the band observer's model
+  (:func:`~.band_bank.build_band_bank`: damped resonators weighted by the measured spectrum, a
+  random-walk offset) in its decorrelated ``"increment"`` form: the measurement is the mean
+  acceleration of a step y = C x + v, and the prediction x⁺ = Ā x + J y (Simon 2006, 7.1;
+  :mod:`.oscillator_bank`);
+* the drift (p_d, v_d) is a constant-velocity model driven by white acceleration of density
+  q_d (filterpy ``Q_continuous_white_noise``). It carries what the accelerometer does not see
+  (a vessel on station or drifting steadily has no acceleration of its own below the waves):
+  it has no row in C;
+* the acceleration of a step updates the band and the offset (R of the band model); a GNSS
+  position of the axis, z = Σ heave_j + p_d + e (σ :data:`FIX_SIGMA`), updates everything,
+  so the position fixes anchor the wave states too.
+
+The covariance is propagated in full (not a steady-state gain): the fixes come at another rate
+than the acceleration and stop in a gap, where the filter turns, step by step, into the
+acceleration-only observer. With no fix ever, and started on the band model's steady-state
+covariance, it *is* that observer (a test checks the states to 1e-9).
+
+Written out rather than with filterpy's ``KalmanFilter``: every measurement here is a scalar,
+for which the plain update K = P hᵀ/s, P ← P − s K Kᵀ costs O(n²), and filterpy's Joseph-form
+update O(n³) (n ≈ 60-220): the fusion of the 340 s dropout record below took about 6.5 s with
+filterpy's filter and 5 s written out (4 s with the line coast before). A test runs the same
+sequence through a filterpy ``KalmanFilter`` and compares.
+
+When the band observer's spectrum changes the element set (every
+:data:`~.wave_coast.PEAK_INTERVAL` s), state and covariance are carried by
+:func:`~.oscillator_bank.carry_map` (P ← T P Tᵀ); an element with no predecessor starts from the
+new model's steady-state covariance, uncorrelated with the rest. Two alternatives were worse on
+east (30 dropouts below): the new model's steady-state covariance for the whole band (what the
+fixes told is lost when the change falls at the start of a gap), and that covariance less the
+carried reduction the fixes made.
+
+Measured on the paper-001 set-up (1 Hz RTK, a 30 s dropout, max error through the gap of the
+fused real-time output, seeds 1-10):
+
+* dropout at 300 s (the test's): east 8.4 / 4.7 / 8.4 / 9.4 / 6.2 / 5.7 / 7.5 / 6.1 / 9.0 /
+  5.7 cm, against 8.4 / 3.8 / 11.2 / 12.0 / 6.0 / 7.9 / 9.5 / 10.3 / 8.2 / 8.1 cm with the line
+  through the anchors; north at most 5.7 cm, down at most 8.0 cm (line: 5.7 and 6.0 cm);
+* dropouts at 270, 300 and 320 s (30 cases): east over 10 cm in 5 (at most 15.2 cm, seed 9 at
+  270 s), mean 7.9 cm; with the line 12 (at most 14.6 cm).
+
+What is left on east is mostly the band observer's own response on acceleration alone: with
+perfect sensors seed 9 at 270 s still errs 10.1 cm (15.2 cm real). Its horizontal offset
+(:data:`~.wave_coast.HORIZONTAL_OFFSET_NOISE`) must follow g × the tilt the gyro bias builds in
+a gap (3 mrad in 25 s on that case), and so takes a few percent of the sway at the wave peak
+(|1 − H| 3 % at 0.77 rad/s, 13 % at 1.3 rad/s); lower offset noise, an offset-rate state,
+and a smoothed spectrum were all worse (README, paper 001).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from filterpy.common import Q_continuous_white_noise
+
+from .oscillator_bank import BankModel, carry_map
+
+#: Standard deviation of a GNSS position of the accelerometer point, per axis [m]. Four RTK
+#: antennas (1 cm) average to 0.5 cm, and the lever arm turned with the propagated attitude adds
+#: its share; of 0.5, 1, 2 and 5 cm, 2 cm coasted best (max east error through the dropout of
+#: seeds 1-3: 9.2 / 5.6 / 8.5, 8.9 / 5.1 / 8.5, 8.4 / 4.8 / 8.4, 8.4 / 4.5 / 8.7 cm).
+FIX_SIGMA = 0.02
+#: Prior standard deviations of the drift position [m] and velocity [m/s] at a (re)start.
+DRIFT_PRIOR = (10.0, 1.0)
+
+
+def drift_noise(window: float, sigma: float = FIX_SIGMA, fix_interval: float = 1.0) -> float:
+    """Acceleration density q_d [m²/s³] of the drift model that remembers about ``window`` s.
+
+    A constant-velocity Kalman filter with position noise of density r = σ²·T (fixes of σ
+    every T s) settles to the bandwidth ω_n = (q_d/r)^(1/4); q_d = σ²T(2π/window)⁴ makes that
+    one cycle per ``window``, the span the line through the anchors used to fit.
+
+    Examples
+    --------
+    >>> f"{drift_noise(120.0):.2e}"
+    '3.00e-09'
+    """
+    return sigma**2 * fix_interval * (2.0 * math.pi / window) ** 4
+
+
+class AidedBand:
+    """Band elements, offset and drift of one axis in one Kalman filter (module docstring).
+
+    Parameters
+    ----------
+    q_drift : float
+        Acceleration density of the drift model [m²/s³] (:func:`drift_noise`), > 0.
+    dt : float
+        Step of the acceleration samples [s] (that of the band observer's model).
+
+    Examples
+    --------
+    >>> f = AidedBand(drift_noise(120.0), 0.05)
+    >>> f.fix(1.5, 0.0)           # no band model yet: the drift alone takes the fix
+    >>> round(f.position(0.0), 6)
+    1.5
+    """
+
+    def __init__(self, q_drift: float, dt: float) -> None:
+        self.q_drift = float(q_drift)
+        self.dt = float(dt)
+        self.model: BankModel | None = None
+        self.prev: float | None = None      # previous acceleration sample [m/s²]
+        self.fixes = 0                      # fixes since the last drift restart
+        self._configure()
+        self.x = np.zeros(2)                # state (module docstring)
+        self.P = np.diag(np.square(DRIFT_PRIOR))
+
+    # ---- model -------------------------------------------------------------------------------
+    @property
+    def n_band(self) -> int:
+        """Band elements' and offset states (0 without a model)."""
+        return 0 if self.model is None else self.model.n
+
+    def _configure(self) -> None:
+        """Transition F, feed-through J, process noise Q and acceleration row C of the current
+        model plus the drift."""
+        m, n = self.model, self.n_band
+        self.F = np.eye(n + 2)
+        self.F[-2, -1] = self.dt
+        self.Q = np.zeros((n + 2, n + 2))
+        self.Q[-2:, -2:] = Q_continuous_white_noise(2, self.dt, self.q_drift)
+        self.J = np.zeros(n + 2)
+        self.C = np.zeros(n + 2)
+        if m is not None:
+            self.F[:n, :n] = m.A_bar
+            self.J[:n] = m.J
+            self.Q[:n, :n] = m.Q
+            self.C[:n] = m.C
+        self.rows = np.zeros((2, n + 2))    # position and velocity of the axis
+        if m is not None:
+            self.rows[:, :n] = m.heave_rows
+        self.rows[0, -2] = self.rows[1, -1] = 1.0
+
+    def follow(self, model: BankModel, band_state: np.ndarray) -> None:
+        """Adopt the band observer's (new) model, built for this filter's step.
+
+        The first model starts the band at ``band_state`` (the observer's own, replayed over its
+        window) with the model's steady-state covariance; a later one carries state and
+        covariance over (module docstring).
+        """
+        old, n_new = self.model, model.n
+        t = np.zeros((n_new + 2, self.n_band + 2))
+        t[-2:, -2:] = np.eye(2)
+        if old is not None:
+            t[:n_new, :old.n] = carry_map(old.omega, model.omega, model.block)
+        x, p = t @ self.x, t @ self.P @ t.T
+        if old is None:
+            x[:n_new] = band_state
+        fresh = np.flatnonzero(~t[:n_new].any(axis=1))
+        p[fresh, :] = 0.0
+        p[:, fresh] = 0.0
+        p[np.ix_(fresh, fresh)] = model.P[np.ix_(fresh, fresh)]
+        self.model = model
+        self._configure()
+        self.x, self.P = x, p
+
+    # ---- measurements ------------------------------------------------------------------------
+    def accelerate(self, a: float) -> None:
+        """One step with the mean acceleration ``a`` [m/s²] of the step: the update with the
+        mean of this and the previous sample, then the prediction to now (without a band model
+        the drift is only predicted)."""
+        if self.model is None:
+            self._predict(0.0)
+            return
+        if self.prev is None:                   # first sample: nothing to average
+            self.prev = a
+            return
+        y = 0.5 * (self.prev + a)
+        self.prev = a
+        self._update(y, self.C, self.model.R)
+        self._predict(y)
+
+    def fix(self, z: float, lead: float, sigma: float = FIX_SIGMA) -> None:
+        """Update with a GNSS position ``z`` [m] of the axis taken ``lead`` s after the band
+        states' time (the end of the last band step); ``sigma`` its standard deviation [m]."""
+        self._update(z, self._row(lead), sigma**2)
+        self.fixes += 1
+
+    def position(self, lead: float) -> float:
+        """Position of the axis [m] ``lead`` s after the band states' time (moved on by the rate)."""
+        return float(self._row(lead) @ self.x)
+
+    def _row(self, lead: float) -> np.ndarray:
+        return self.rows[0] + lead * self.rows[1]
+
+    def _update(self, z: float, h: np.ndarray, r: float) -> None:
+        """Kalman update with a scalar measurement z = h x + v, Var v = r."""
+        ph = self.P @ h
+        s = float(h @ ph) + r
+        k = ph / s
+        self.x = self.x + k * (z - float(h @ self.x))
+        self.P = self.P - np.outer(k, ph)
+
+    def _predict(self, y: float) -> None:
+        """x ← F x + J y, P ← F P Fᵀ + Q."""
+        self.x = self.F @ self.x + self.J * y
+        p = self.F @ self.P @ self.F.T + self.Q
+        self.P = 0.5 * (p + p.T)
+
+    def restart_drift(self) -> None:
+        """Forget the drift (the fusion re-initialised: a real reposition)."""
+        x, p = self.x, self.P
+        p[-2:, :] = 0.0
+        p[:, -2:] = 0.0
+        p[-2:, -2:] = np.diag(np.square(DRIFT_PRIOR))
+        x[-2:] = 0.0
+        self.fixes = 0
+
+    # ---- state -------------------------------------------------------------------------------
+    def get_state(self) -> dict:
+        """JSON-serialisable state (the model is the band observer's, restored with it)."""
+        return {"x": self.x.tolist(), "P": self.P.tolist(), "prev": self.prev, "fixes": self.fixes}
+
+    def set_state(self, s: dict, model: BankModel | None) -> None:
+        """Restore a state from :meth:`get_state` with the band observer's restored ``model``."""
+        self.model = model
+        self._configure()
+        self.x = np.array(s["x"], dtype=float)
+        self.P = np.array(s["P"], dtype=float)
+        self.prev = s["prev"]
+        self.fixes = int(s["fixes"])

@@ -1,0 +1,135 @@
+"""The GNSS-aided band observer of the dropout coast (estimators.aided_band, estimators.wave_coast)."""
+import json
+import math
+
+import numpy as np
+import pytest
+from filterpy.kalman import KalmanFilter
+
+from marinefmu.estimators.aided_band import FIX_SIGMA, AidedBand, drift_noise
+from marinefmu.estimators.band_bank import band_grid, build_band_bank
+from marinefmu.estimators.wave_coast import WaveCoast
+
+DT = 0.05
+
+
+def band_model(omega_min=0.4, omega_max=2.0, count=8, peak=0.8):
+    """A band model on a JONSWAP-like heave variance per element (the coast's settings)."""
+    omega = band_grid(omega_min, omega_max, count)
+    variance = 0.05 * np.exp(-((omega - peak) / 0.25) ** 2)
+    return build_band_bank(omega, variance, DT, 0.1, 3, 1e-3, 7e-4)
+
+
+def steady_state_step(m, x, y):
+    """The band observer's own recursion (heave.HeaveObserver._process, increment model)."""
+    post = x + m.K * (y - float(m.C @ x))
+    return m.A_bar @ post + m.J * y
+
+
+def test_without_fixes_it_is_the_steady_state_band_observer():
+    """Started on the model's steady-state covariance and never given a fix, the full-covariance
+    filter stays at that covariance, so its band states are the steady-state observer's
+    (2000 steps of seeded acceleration, to 1e-9 m of state)."""
+    m = band_model()
+    rng = np.random.default_rng(1)
+    acc = 0.2 * np.sin(0.8 * DT * np.arange(2001)) + rng.normal(0.0, 0.01, 2001)
+    f = AidedBand(drift_noise(120.0), DT)
+    f.follow(m, np.zeros(m.n))
+    x = np.zeros(m.n)
+    f.accelerate(float(acc[0]))
+    for k in range(1, len(acc)):
+        f.accelerate(float(acc[k]))
+        x = steady_state_step(m, x, 0.5 * (acc[k - 1] + acc[k]))
+    assert np.max(np.abs(f.x[:m.n] - x)) < 1e-9
+    assert np.max(np.abs(f.P[:m.n, :m.n] - m.P)) < 1e-9 * np.max(np.abs(m.P))
+
+
+def test_agrees_with_a_filterpy_kalman_filter():
+    """The same acceleration steps and 1 Hz fixes through filterpy's KalmanFilter (Joseph form)
+    give the same state and covariance to 1e-9 relative: the written-out scalar update is the
+    Kalman update."""
+    m = band_model()
+    n = m.n + 2
+    f = AidedBand(drift_noise(120.0), DT)
+    f.follow(m, np.zeros(m.n))
+    kf = KalmanFilter(dim_x=n, dim_z=1, dim_u=1)
+    kf.F, kf.Q, kf.B = f.F.copy(), f.Q.copy(), f.J[:, None].copy()
+    kf.x, kf.P = f.x[:, None].copy(), f.P.copy()
+    rng = np.random.default_rng(2)
+    t = DT * np.arange(1201)
+    pos = 0.3 * np.sin(0.8 * t) + 0.02 * t
+    acc = -0.3 * 0.64 * np.sin(0.8 * t) + rng.normal(0.0, 0.003, len(t))
+    f.accelerate(float(acc[0]))
+    for k in range(1, len(t)):
+        f.accelerate(float(acc[k]))
+        y = 0.5 * (acc[k - 1] + acc[k])
+        kf.update(y, R=m.R, H=f.C[None, :])
+        kf.predict(u=y)
+        if k % 20 == 0:
+            z = float(pos[k] + rng.normal(0.0, 0.01))
+            f.fix(z, 0.0)
+            kf.update(z, R=FIX_SIGMA ** 2, H=f.rows[0][None, :])
+    assert np.max(np.abs(f.x - kf.x[:, 0])) < 1e-9 * np.max(np.abs(kf.x))
+    assert np.max(np.abs(f.P - kf.P)) < 1e-9 * np.max(np.abs(kf.P))
+
+
+def test_a_new_element_set_keeps_the_position_and_its_rate():
+    """A change of the band model's elements carries the states (carry_map): position and
+    rate are continuous to 1e-12 m, and an element with no predecessor starts uncorrelated."""
+    old, new = band_model(count=8), band_model(omega_min=0.3, count=10)
+    f = AidedBand(drift_noise(120.0), DT)
+    f.follow(old, np.zeros(old.n))
+    rng = np.random.default_rng(3)
+    for k in range(400):
+        f.accelerate(float(0.1 * math.sin(0.8 * DT * k) + rng.normal(0.0, 0.01)))
+        if k % 20 == 19:
+            f.fix(float(0.15 * math.sin(0.8 * DT * k) + 1.0), 0.0)
+    before = (f.position(0.0), f.position(0.2))
+    f.follow(new, np.zeros(new.n))
+    assert f.position(0.0) == pytest.approx(before[0], abs=1e-12)
+    assert f.position(0.2) == pytest.approx(before[1], abs=1e-12)
+    assert np.all(np.linalg.eigvalsh(f.P) > -1e-12)
+
+
+def test_coast_state_round_trips_through_json():
+    """Save at 150 s (JSON, as the FMU does), run both copies on to 200 s: the coast positions
+    are bit-identical."""
+    t = DT * np.arange(1, int(200 / DT) + 1)
+    w = 2 * math.pi / 9.0
+    acc = np.stack([-0.4 * w * w * np.sin(w * t + p) for p in (0.0, 1.0, 2.0)], axis=1)
+    pos = np.stack([0.4 * np.sin(w * t + p) for p in (0.0, 1.0, 2.0)], axis=1)
+    a = WaveCoast(120.0)
+    b = WaveCoast(120.0)
+    out_a, out_b = [], []
+    for k in range(len(t)):
+        if k == int(150 / DT):
+            b.set_state(json.loads(json.dumps(a.get_state())))
+        for c, out in ((a, out_a), (b, out_b)):
+            if c is b and k < int(150 / DT):
+                continue
+            c.add(acc[k], DT)
+            if k % 20 == 19:
+                c.anchor(pos[k])
+            if k >= int(150 / DT):
+                out.append(c.position())
+    assert out_a[-1] is not None
+    assert np.array_equal(np.array(out_a), np.array(out_b))
+
+
+def test_no_position_before_the_spectrum_or_long_after_the_last_fix():
+    """position() is None until the band observers have their first spectrum and three fixes
+    followed; and once ``window`` s have passed without a fix."""
+    c = WaveCoast(60.0)
+    w = 2 * math.pi / 8.0
+    given = []
+    for k in range(1, int(300 / DT) + 1):
+        t = k * DT
+        c.add(np.full(3, -0.3 * w * w * math.sin(w * t)), DT)
+        if t <= 200.0 and k % 20 == 0:
+            c.anchor(np.full(3, 0.3 * math.sin(w * t)))
+        if t < 120.0:
+            assert c.position() is None
+        if 130.0 <= t <= 250.0 and k % 100 == 0:
+            given.append(c.position() is not None)
+    assert all(given)                                 # 130-250 s: 50 s after the last fix < 60 s
+    assert c.position() is None                       # 300 s: 100 s after it > window 60 s
