@@ -116,7 +116,7 @@ FUSION_PARAMETERS: list[Variable] = [
     real("max_coast", _FU.max_coast, "s", "valid goes false this long after the last accepted fix, > 0"),
     Variable("coast", "string", _FU.coast, "", f"Through a GNSS gap: one of {', '.join(COAST_CHOICES)} (wave-model pseudo-fixes for a vessel on station or moving steadily, or prediction only)"),
     real("coast_sigma", _FU.coast_sigma, "m", "Standard deviation of a wave-model pseudo-fix, (0, 10]"),
-    real("coast_window", _FU.coast_window, "s", "Span of GNSS anchors for the low-frequency line of coast = band, 10..3600"),
+    real("coast_window", _FU.coast_window, "s", "Memory of the drift model of coast = band and the longest gap it bridges, 10..3600"),
 ]
 FUSION_INPUTS: list[Variable] = [
     *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),

@@ -49,8 +49,8 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    VesselMotion's default gyro, perfectly initialised). ``"band"`` (default) assumes what holds
    for a floating platform or a vessel on station: the low-frequency position moves along a
    straight line through the gap. Once no fix has come for :data:`COAST_AFTER` s, the
-   position of :class:`~.wave_coast.WaveCoast` (band observers of the wave-frequency motion
-   plus a line through the last ``coast_window`` s of GNSS anchors) updates the filter every
+   position of :class:`~.wave_coast.WaveCoast` (per axis, the band observer's wave model and a
+   drift in one Kalman filter that the fixes update too, :mod:`.aided_band`) updates the filter every
    :data:`COAST_INTERVAL` s as a pseudo-fix of standard deviation ``coast_sigma`` (not gated;
    ``fix`` is ``"wave"``). Measured on the paper's set-up (1 Hz, 30 s dropout, seeds 1-3): see the README.
 """
@@ -147,7 +147,8 @@ class FusionParams:
         Standard deviation of a wave-model pseudo-fix [m], (0, 10]; one every
         :data:`COAST_INTERVAL` s. [``coast_sigma``]
     coast_window : float
-        Span of GNSS anchors for the low-frequency line of ``coast="band"`` [s], 10 … 3600.
+        Memory of the drift model of ``coast="band"`` (:func:`~.aided_band.drift_noise`), and
+        the longest time after the last fix that it still gives pseudo-fixes [s], 10 … 3600.
         [``coast_window``]
     """
 

@@ -228,7 +228,7 @@ def faults(duration: float = 360.0, start: float = 300.0) -> dict:
     """A 20 m GNSS jump lasting 10 s, and a 30 s dropout, both at ``start`` s, 1 Hz GNSS.
     Returns the largest deviation [m] of the fused COG from the fault-free run during the jump
     window, and the largest 3-D error [m] against truth through the dropout (``start`` leaves
-    the wave-model coast its 120 s spectrum window and 120 s of GNSS anchors)."""
+    the wave-model coast its 120 s spectrum window and 120 s of GNSS fixes)."""
     base = simulate(duration, {"gnss.rate": 1.0})
     ref = fuse(base["acc"], DT, base["gnss"], base["gnss_new"], base["gyro"], params())
     jump = simulate(duration, {"gnss.rate": 1.0, "gnss.jump.start": start, "gnss.jump.duration": 10.0,
