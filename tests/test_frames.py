@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from marinefmu.frames import GRAVITY_N, attitude_kinematics, euler_rates_to_body, rigid_point_operator, rot_nb, specific_force
+from marinefmu.frames import GRAVITY_N, attitude_kinematics, cross3, euler_rates_to_body, rigid_point_operator, rot_nb, specific_force
 
 rng = np.random.default_rng(3)
 ANGLES = rng.uniform([-0.5, -0.4, -3.1], [0.5, 0.4, 3.1], size=(20, 3))
@@ -44,3 +44,10 @@ def test_rigid_point_operator_is_cross_products():
     np.testing.assert_allclose(body[:3], arm, atol=1e-15)
     np.testing.assert_allclose(body[3:6], np.cross(w, arm), atol=1e-15)
     np.testing.assert_allclose(body[6:9], np.cross(a, arm) + np.cross(w, np.cross(w, arm)), atol=1e-14)
+
+
+def test_cross3_is_numpy_cross():
+    """The written-out cross product equals np.cross bit for bit on seeded random vectors."""
+    rng = np.random.default_rng(4)
+    for a, b in rng.normal(size=(50, 2, 3)):
+        assert np.array_equal(cross3(a, b), np.cross(a, b))

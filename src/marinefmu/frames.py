@@ -12,6 +12,7 @@ against scipy's Rotation to 1e-15.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -161,6 +162,13 @@ def rigid_point_operator(w: list[float], a: list[float]) -> np.ndarray:
 def specific_force(rot: np.ndarray, acc_n: np.ndarray) -> np.ndarray:
     """Specific force in the body frame, f_b = R_nbᵀ (a_n − g_n) [m/s²]."""
     return rot.T @ (acc_n - GRAVITY_N)
+
+
+def cross3(a: Any, b: Any) -> np.ndarray:
+    """a × b of two 3-vectors. Written out for the per-step hot path: ``np.cross`` spends about
+    40 µs per call on axis handling (measured: a fifth of GnssAccFusion's step); a test checks
+    it against ``np.cross``."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 # --- Unit quaternions q = [w, x, y, z] (scalar first, Hamilton product) representing R_nb --------

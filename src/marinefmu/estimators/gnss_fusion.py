@@ -66,7 +66,7 @@ from filterpy.kalman import KalmanFilter
 from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError, ShapeError, check_choice, check_range, check_vector
-from ..frames import GRAVITY_N, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
+from ..frames import GRAVITY_N, cross3, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
 from .samples import force_beyond_limit, rate_beyond_limit
 from .wave_coast import WaveCoast
 
@@ -518,7 +518,7 @@ class GnssAccFusion:
         pos = x[:3] - arm if self.initialised else np.zeros(3)
         vel = x[3:6].copy()
         if w is not None and self.initialised:
-            vel -= rot @ np.cross(w - self.gyro_bias, p.acc_lever_arm)
+            vel -= rot @ cross3(w - self.gyro_bias, p.acc_lever_arm)
         std = np.sqrt(np.diag(self.kf.P)[:3]) if self.initialised else np.zeros(3)  # valid is False then
         bias = x[6:9] if p.bias_states else np.zeros(3)
         euler = quat_to_euler(self.q)
