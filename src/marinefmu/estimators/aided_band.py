@@ -61,7 +61,7 @@ perfect sensors seed 9 at 270 s still errs 10.1 cm (15.2 cm real). Its horizonta
 (:data:`~.wave_coast.HORIZONTAL_OFFSET_NOISE`) must follow g × the tilt the gyro bias builds in
 a gap (3 mrad in 25 s on that case), and so takes a few percent of the sway at the wave peak
 (|1 − H| 3 % at 0.77 rad/s, 13 % at 1.3 rad/s); lower offset noise, an offset-rate state,
-and a smoothed spectrum were all worse (README, paper 001).
+another offset noise in gaps only, and a smoothed spectrum were all worse (README, paper 001).
 """
 from __future__ import annotations
 
