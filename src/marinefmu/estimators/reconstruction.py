@@ -44,10 +44,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg, signal
-from threadpoolctl import ThreadpoolController
 
 from ..errors import ParameterError, ShapeError, check_choice, check_int, check_range
 from ..frames import G
+from .blas import one_blas_thread
 
 TILT_CHOICES = ("exact", "small_angle")
 STOP_CHOICES = ("sc_sw", "residual")
@@ -220,24 +220,6 @@ class Decomposition:
         out["phase"] = np.angle(gam)
         out["kept"] = kept
         return np.sort(out, order="frequency")
-
-
-_BLAS: ThreadpoolController | None = None
-
-
-def one_blas_thread():
-    """Context manager that runs BLAS/LAPACK on one thread (threadpoolctl), restoring the
-    previous setting on exit.
-
-    The decomposition's matrices are small (≈ 500 × 500 SVDs, 1000 × 120 least squares), and
-    OpenBLAS's thread synchronisation costs more than it gains on them: measured 2026-11-22
-    on this project's 2-core machine, one hour of 100 Hz three-axis acceleration took 14.9 s
-    with OpenBLAS's default two threads and 6.7 s with one (same results to 1e-12 m).
-    Running (segment, axis) fits in parallel Python threads instead gained nothing (7.7 s)."""
-    global _BLAS
-    if _BLAS is None:
-        _BLAS = ThreadpoolController()
-    return _BLAS.limit(limits=1, user_api="blas")
 
 
 def hankel_pair(x: np.ndarray, rows: int) -> tuple[np.ndarray, np.ndarray]:

@@ -44,6 +44,7 @@ import numpy as np
 
 from ..frames import G
 from .aided_band import AidedBand, drift_noise
+from .blas import one_blas_thread
 from .heave import HeaveObserver, HeaveObserverParams
 
 #: Target rate of the band observers [Hz] (block means of the accelerometer samples).
@@ -112,12 +113,13 @@ class WaveCoast:
         mean = self.acc_sum / self.block
         self.acc_sum[:] = 0.0
         self.in_block = 0
-        for obs, band, a in zip(self.observers, self.bands, mean):
-            # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g
-            obs.step(float(a) - G, 0.0, 0.0, self.block * self.dt)
-            if obs.model is not None and obs.model is not band.model:
-                band.follow(obs.model, obs.xp)
-            band.accelerate(float(a))
+        with one_blas_thread():                 # the filters' products are small (blas module)
+            for obs, band, a in zip(self.observers, self.bands, mean):
+                # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g
+                obs.step(float(a) - G, 0.0, 0.0, self.block * self.dt)
+                if obs.model is not None and obs.model is not band.model:
+                    band.follow(obs.model, obs.xp)
+                band.accelerate(float(a))
         self.k_band = self.k
 
     def _start(self, dt: float) -> None:
