@@ -178,12 +178,12 @@ def test_a_20_m_jump_is_gated_out():
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
-    """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 120 s window and 180 s of
-    fixes before it). Real time with ``coast="band"`` (default, the GNSS-aided band observer of
-    estimators.aided_band): measured max per axis 1.9-4.3 / 4.7-8.4 / 3.0-5.4 cm north / east /
-    down over seeds 1-3 (the line coast before it: east 8.4 / 3.8 / 11.2 cm), against metres for
-    the inertial coast (README). The goal, 10 cm per axis, is the bound. RTS-smoothed through
-    the gap: measured max 1.4-2.7 / 3.3-6.4 / 2.0-4.0 cm (bound 10 cm). Back within 5 cm (3-D)
+    """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 180 s spectrum window and 120 s
+    of fixes before it). Real time with ``coast="band"`` (default, the GNSS-aided band observer
+    of estimators.aided_band): measured max per axis 1.9-4.3 / 3.7-8.4 / 3.2-5.6 cm north /
+    east / down over seeds 1-3 (the line coast before it: east 8.4 / 3.8 / 11.2 cm), against
+    metres for the inertial coast (README). The goal, 10 cm per axis, is the bound.
+    RTS-smoothed through the gap: measured max 1.4-2.7 / 3.6-6.3 / 2.1-3.9 cm (bound 10 cm). Back within 5 cm (3-D)
     5 s after the fixes return, and valid throughout (within max_coast)."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
                                     "sea.seed": seed, "sensors.seed": seed})

@@ -149,7 +149,8 @@ class FusionParams:
     coast_window : float
         Memory of the drift model of ``coast="band"`` (:func:`~.aided_band.drift_noise`), and
         the longest time after the last fix that it still gives pseudo-fixes [s], 10 … 3600.
-        [``coast_window``]
+        The coast has no position before its spectrum window
+        (:data:`~.wave_coast.SPECTRUM_WINDOW`, 180 s) has passed. [``coast_window``]
     """
 
     antennas: tuple = DEFAULT_ANTENNAS

@@ -10,9 +10,10 @@ wave band, so there the accelerometer's low-frequency content is error, not moti
 Method, per NED axis:
 
 1. a band observer — :class:`~.heave.HeaveObserver` with ``model="band"``, the heave observer of
-   paper 003, run on one axis of the attitude-corrected acceleration a_n at the accelerometer,
-   decimated to about :data:`RATE` Hz by block means — measures the sea's spectrum along the
-   axis and builds the model of its wave-frequency motion (band elements and an offset);
+   paper 003 with a :data:`SPECTRUM_WINDOW` s spectrum window, run on one axis of the
+   attitude-corrected acceleration a_n at the accelerometer, decimated to about :data:`RATE` Hz
+   by block means — measures the sea's spectrum along the axis and builds the model of its
+   wave-frequency motion (band elements and an offset);
 2. :class:`~.aided_band.AidedBand` runs that model in one Kalman filter with a
    constant-velocity drift, updated by the acceleration at every band step and by every
    accepted GNSS fix z of the accelerometer point, so the fixes anchor the wave states as well
@@ -24,7 +25,8 @@ Until 2026-11-22 step 2 was the band observer alone plus a straight line fitted 
 z − d_w of the last ``window`` s; its wave displacement d_w carried g × the antenna-attitude
 error at 0.1-0.3 rad/s (3.5 cm RMS east before the gap on the paper-001 set-up), which the
 fixes now remove (:mod:`.aided_band`, with the figures). The error left is the band
-observer's acceleration-only response through the gap. A vessel that manoeuvres during the gap
+observer's acceleration-only response through the gap, whose offset must follow g × the
+attitude error of the corrected acceleration (:mod:`.aided_band`). A vessel that manoeuvres during the gap
 breaks the drift assumption: use ``coast="inertial"`` in :class:`~.gnss_fusion.FusionParams`
 then. :class:`~.gnss_fusion.GnssAccFusion` feeds the coast position to its Kalman filter as a
 pseudo-fix every 0.1 s while GNSS is missing.
@@ -39,6 +41,7 @@ displacement (with the aided filter, over the 30 dropouts of :mod:`.aided_band`,
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -53,6 +56,14 @@ RATE = 20.0
 HORIZONTAL_OFFSET_NOISE = 1e-3
 #: Fewest fixes before the coast gives a position.
 MIN_FIXES = 3
+#: Spectrum window of the band observers [s]: the coast gives positions from this long into a
+#: run. Measured (max east error through a 30 s dropout at 1 Hz, paper-001 set-up, fused real
+#: time): over the 30 dropouts at 270 / 300 / 320 s of seeds 1-10, over 10 cm in 5 with the
+#: heave observer's 120 s (mean 7.9 cm, worst 15.2), 2 with 180 s (7.1 cm, worst 13.7) and
+#: 2 with 240 s (7.3 cm, worst 14.1); on 10 more (seeds 11-20 at 400 s, not used to choose)
+#: 2 over 10 cm with 120 s (mean 8.2 cm) and 3 with 180 s (7.6 cm, all three 10.2-10.5 cm).
+#: A longer window resolves the sea's spectrum, and so the band elements' weights, more finely.
+SPECTRUM_WINDOW = 180.0
 #: Time between the band observers' spectrum updates [s]. The sea state changes over tens of
 #: minutes; the heave observer's 15 s (paper 003) here cost 60 % of the fusion's time (three
 #: 217-state steady-state filters rebuilt with ``dlqe``) for no better coast: the 30 s dropout
@@ -70,6 +81,9 @@ class WaveCoast:
     window : float
         Memory of the drift model [s] (:func:`~.aided_band.drift_noise`), and the longest time
         without a fix after which the coast gives no position, > 0.
+    spectrum_window : float
+        Spectrum window of the band observers [s] (:data:`SPECTRUM_WINDOW`); no position
+        before it has passed, ≥ 4π/``omega_min`` of the heave observer (50.3 s).
 
     Examples
     --------
@@ -79,16 +93,17 @@ class WaveCoast:
     True
     """
 
-    def __init__(self, window: float) -> None:
+    def __init__(self, window: float, spectrum_window: float = SPECTRUM_WINDOW) -> None:
         self.window = float(window)
+        self.spectrum_window = float(spectrum_window)
         self.reset()
 
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
-        horizontal = HeaveObserverParams(offset_noise=HORIZONTAL_OFFSET_NOISE, smoother_lag=0.0,
-                                         peak_interval=PEAK_INTERVAL)
+        vertical = HeaveObserverParams(smoother_lag=0.0, peak_interval=PEAK_INTERVAL, window=self.spectrum_window)
+        horizontal = replace(vertical, offset_noise=HORIZONTAL_OFFSET_NOISE)
         self.observers = [HeaveObserver(horizontal, quiet=True), HeaveObserver(horizontal, quiet=True),
-                          HeaveObserver(HeaveObserverParams(smoother_lag=0.0, peak_interval=PEAK_INTERVAL), quiet=True)]
+                          HeaveObserver(vertical, quiet=True)]
         self.dt: float | None = None
         self.block = 1                      # accelerometer samples per observer step
         self.k = 0                          # accelerometer samples seen (time = k·dt)
