@@ -116,6 +116,7 @@ FUSION_PARAMETERS: list[Variable] = [
     real("max_coast", _FU.max_coast, "s", "valid goes false this long after the last accepted fix, > 0"),
     Variable("coast", "string", _FU.coast, "", f"Through a GNSS gap: one of {', '.join(COAST_CHOICES)} (wave-model pseudo-fixes for a vessel on station or moving steadily, or prediction only)"),
     real("coast_sigma", _FU.coast_sigma, "m", "Standard deviation of a wave-model pseudo-fix, (0, 10]"),
+    real("coast_attitude_tau", _FU.coast_attitude_tau, "s", "Time constant of the coast's own PI attitude (coast = band, propagation = gyro), 0.1..10000"),
     real("coast_window", _FU.coast_window, "s", "Memory of the drift model of coast = band and the longest gap it bridges, 10..3600"),
 ]
 FUSION_INPUTS: list[Variable] = [
@@ -151,7 +152,8 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
         q=v["q"], q_down=v["q_down"] or None, r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
-        coast=v["coast"], coast_sigma=v["coast_sigma"], coast_window=v["coast_window"],
+        coast=v["coast"], coast_sigma=v["coast_sigma"], coast_attitude_tau=v["coast_attitude_tau"],
+        coast_window=v["coast_window"],
     )
 
 

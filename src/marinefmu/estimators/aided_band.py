@@ -48,27 +48,29 @@ fixes told is lost when the change falls at the start of a gap), and that covari
 carried reduction the fixes made.
 
 Measured on the paper-001 set-up (1 Hz RTK, a 30 s dropout, max error through the gap of the
-fused real-time output, seeds 1-10; band observers' spectrum window
-:data:`~.wave_coast.SPECTRUM_WINDOW` 180 s, figures with the earlier 120 s in brackets):
+fused real-time output; the coast's acceleration corrected with its own attitude
+(``coast_attitude_tau`` 150 s of :class:`~.gnss_fusion.FusionParams`), spectrum window
+:data:`~.wave_coast.SPECTRUM_WINDOW` 180 s; in brackets the earlier settings, the fusion's
+attitude and a 120 s window):
 
-* dropout at 300 s (the test's): east 8.4 / 3.7 / 8.3 / 8.7 / 5.9 / 6.8 / 6.4 / 5.3 / 7.7 /
-  3.7 cm (8.4 / 4.7 / 8.4 / 9.4 / 6.2 / 5.7 / 7.5 / 6.1 / 9.0 / 5.7), against 8.4 / 3.8 / 11.2
-  / 12.0 / 6.0 / 7.9 / 9.5 / 10.3 / 8.2 / 8.1 cm with the line through the anchors; north at
-  most 5.7 cm, down at most 6.5 cm (8.0; line: 5.7 and 6.0 cm);
-* dropouts at 270, 300 and 320 s (30 cases): east over 10 cm in 2, at most 13.7 cm (seed 9 at
-  270 s), mean 7.1 cm (5, 15.2 cm, 7.9 cm); with the line 12 (at most 14.6 cm);
-* dropouts at 400 s of seeds 11-20 (not used to choose anything): over 10 cm in 3, all
-  10.2-10.5 cm, mean 7.6 cm (2, 10.5 cm, 8.2 cm).
+* dropout at 300 s (the test's), seeds 1-10: east 7.5 / 3.6 / 9.6 / 8.1 / 6.0 / 7.5 / 6.4 /
+  5.5 / 9.5 / 4.4 cm (8.4 / 4.7 / 8.4 / 9.4 / 6.2 / 5.7 / 7.5 / 6.1 / 9.0 / 5.7), against
+  8.4 / 3.8 / 11.2 / 12.0 / 6.0 / 7.9 / 9.5 / 10.3 / 8.2 / 8.1 cm with the line through the
+  anchors; north at most 5.7 cm, down at most 6.5 cm (8.0; line: 5.7 and 6.0 cm);
+* 40 dropouts, at 270, 300 and 320 s of seeds 1-10 and at 400 s of seeds 11-20: east over
+  10 cm in 1 (10.6 cm, seed 9 at 320 s), mean 6.8 cm (7, at most 15.2 cm, mean 8.0 cm); the
+  line: 12 of the first 30 (at most 14.6 cm).
 
 What is left on east comes from the attitude that corrects the coast's acceleration. The
 horizontal offset (:data:`~.wave_coast.HORIZONTAL_OFFSET_NOISE`) must follow g × that
 attitude's error — the fix noise the PI lets through, and in a gap the tilt the gyro bias
-error builds (0.9 → 3.7 mrad in 25 s on seed 9 at 270 s) — and a loose offset takes a few
-percent of the sway at the wave peak (|1 − H| 3 % at 0.77 rad/s, 13 % at 1.3 rad/s). Given the
-true attitude the heave observer's offset noise does, and that dropout errs 6.6 cm instead of
-13.7-15.2. Lower offset noise, an offset-rate state, another offset noise in gaps only, a
-smoothed spectrum, the fixes' attitude as a measurement of the offset and a slower attitude PI
-(better coast, worse fused output) were measured and not taken (README, paper 001).
+error builds (0.9 → 3.7 mrad in 25 s on seed 9 at 270 s with the fusion's attitude) — and a
+loose offset takes a few percent of the sway at the wave peak (|1 − H| 3 % at 0.77 rad/s, 13 %
+at 1.3 rad/s). Given the true attitude, the heave observer's offset noise does, and that
+dropout errs 6.6 cm (15.2 cm with the fusion's attitude and a 120 s window, 9.4 cm now).
+Lower offset noise, an offset-rate state, another offset noise in gaps only, a smoothed
+spectrum, and the fixes' attitude as a measurement of the offset were measured and not taken
+(README, paper 001).
 """
 from __future__ import annotations
 

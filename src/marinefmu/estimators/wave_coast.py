@@ -57,7 +57,7 @@ HORIZONTAL_OFFSET_NOISE = 1e-3
 #: Fewest fixes before the coast gives a position.
 MIN_FIXES = 3
 #: Spectrum window of the band observers [s]: the coast gives positions from this long into a
-#: run. Measured (max east error through a 30 s dropout at 1 Hz, paper-001 set-up, fused real
+#: run. Measured with the fusion's attitude, before ``coast_attitude_tau`` (max east error through a 30 s dropout at 1 Hz, paper-001 set-up, fused real
 #: time): over the 30 dropouts at 270 / 300 / 320 s of seeds 1-10, over 10 cm in 5 with the
 #: heave observer's 120 s (mean 7.9 cm, worst 15.2), 2 with 180 s (7.1 cm, worst 13.7) and
 #: 2 with 240 s (7.3 cm, worst 14.1); on 10 more (seeds 11-20 at 400 s, not used to choose)
