@@ -354,3 +354,30 @@ def test_highpass_baseline_has_the_analytic_response_and_refuses_a_bad_cutoff():
     assert abs(resp) < 1.0 and np.angle(resp) > 0.05          # the long-wave error it makes
     with pytest.raises(ParameterError, match="cutoff = 0.0 is out of range"):
         highpass_double_integration(np.zeros(10), dt, 0.0)
+
+
+def test_track_spectrum_builds_the_same_models_as_step():
+    """An observer fed by ``track_spectrum`` once it has a model (what WaveCoast does: it runs
+    the model in a filter of its own) buffers the same samples and rebuilds, every
+    ``peak_interval``, exactly the models that ``step`` would. Before the first model it
+    refuses, naming the method to call."""
+    dt, p = 0.05, HeaveObserverParams(window=60.0, peak_interval=15.0, smoother_lag=0.0)
+    t = dt * np.arange(1, int(200 / dt) + 1)
+    f_z = -G - 0.5 * np.sin(0.7 * t) - 0.3 * np.sin(1.3 * t + 1.0)
+    full, lean = HeaveObserver(p), HeaveObserver(p)
+    with pytest.raises(RuntimeError, match="call step until model is set"):
+        lean.track_spectrum(f_z[0], 0.0, 0.0)
+    models = []
+    for f in f_z:
+        full.step(f, 0.0, 0.0, dt)
+        if lean.model is None:
+            lean.step(f, 0.0, 0.0, dt)
+        else:
+            lean.track_spectrum(f, 0.0, 0.0)
+        if lean.model is not None and (not models or models[-1] is not lean.model):
+            models.append(lean.model)
+            assert np.array_equal(full.model.omega, lean.model.omega)
+            assert np.array_equal(full.model.Q, lean.model.Q)
+            assert np.array_equal(full.model.K, lean.model.K)
+    assert len(models) == 10                    # at 60 s, then every 15 s to 195 s
+    assert np.array_equal(full.buf, lean.buf)

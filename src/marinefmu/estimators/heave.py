@@ -450,6 +450,28 @@ class HeaveObserver:
             self._detect()
         return self._finish(good and restarted is None, warning)
 
+    def track_spectrum(self, acc: Any, roll: float, pitch: float) -> None:
+        """Take one sample (as :meth:`step`, same step size) once the model exists, for the
+        spectrum and the model only: it is buffered and the spectrum and model are redone when
+        due, without the Kalman step, whose state then goes stale (``x``, ``xp`` and the
+        outputs are not updated). A bad sample repeats the previous one in the buffer.
+
+        For an estimator that runs the model in a filter of its own
+        (:class:`~.wave_coast.WaveCoast`): the observer's step is then work done twice.
+        """
+        if self.model is None:
+            raise RuntimeError("track_spectrum needs the first model: call step until model is set")
+        f, roll, pitch, warning = read_sample(acc, roll, pitch)
+        self.k += 1
+        if warning is None:
+            row = (vertical_acceleration(f, roll, pitch, self.params.vertical), roll, pitch, 1.0)
+        else:
+            self.log.warning("heave observer: %s; repeating the previous sample in the spectrum", warning)
+            row = (float(self.buf[(self.k - 2) % len(self.buf), 0]), *self.last_angles, 0.0)
+        self.buf[(self.k - 1) % len(self.buf)] = row
+        if self.k >= self.next_detect:
+            self._detect()
+
     # ---- internals ---------------------------------------------------------------------------
     def _buffer(self, a_v: float | None, roll: float, pitch: float) -> None:
         """Store a sample for the spectrum; a bad one is replaced by the model's acceleration

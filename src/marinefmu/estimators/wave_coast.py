@@ -130,8 +130,12 @@ class WaveCoast:
         self.in_block = 0
         with one_blas_thread():                 # the filters' products are small (blas module)
             for obs, band, a in zip(self.observers, self.bands, mean):
-                # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g
-                obs.step(float(a) - G, 0.0, 0.0, self.block * self.dt)
+                # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g;
+                # once it has a model, only its spectrum is used (the band filter runs the model)
+                if obs.model is None:
+                    obs.step(float(a) - G, 0.0, 0.0, self.block * self.dt)
+                else:
+                    obs.track_spectrum(float(a) - G, 0.0, 0.0)
                 if obs.model is not None and obs.model is not band.model:
                     band.follow(obs.model, obs.xp)
                 band.accelerate(float(a))
