@@ -12,7 +12,8 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 
 Then (``parts``): the paper 003 heave accuracy over five seas (:func:`heave_accuracy`),
 marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
-(``orcaflex``), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
+(``orcaflex``), the GNSS dropout coast of paper 001 over 40 dropouts (``dropout``,
+:func:`marinefmu.examples.paper001.dropouts`), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
 seas, speed under FMPy, in-process and libcosim, memory of a 3-hour run), the heave
 compensation's design loop and four-way comparison (``ahc``, :mod:`marinefmu.bench_ahc`), and
 the memory of
@@ -143,7 +144,7 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
 
 
 #: Parts of ``marinefmu bench``, in the order they run.
-PARTS = ("speed", "heave", "peer", "orcaflex", "system", "ahc", "memory")
+PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "system", "ahc", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks: Hs [m], Tp [s]).
@@ -242,7 +243,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     what they measure; return the whole file's data.
 
     ``speed`` takes a few minutes, ``heave`` about five, ``peer`` about one, ``orcaflex`` a
-    few seconds, ``system`` (three seas, three engines and a 3-hour run) about an hour,
+    few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 40 GNSS dropouts) about four, ``system`` (three seas, three engines and a 3-hour run) about an hour,
     ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
     2-core machine."""
     from .cosim.build import build_all, repo_root
@@ -269,6 +270,14 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             data["peer"] = {**stamp, "seas": peer_comparison()}
         elif part == "orcaflex":
             data["orcaflex"] = {**stamp, "scores": orcaflex_comparison()}
+        elif part == "dropout":
+            from .examples import paper001
+
+            d = paper001.dropouts()
+            data["dropout"] = {**stamp, **d}
+            print(f"GNSS dropout coast, {len(d['cases'])} dropouts of {d['duration_s']:g} s: {d['over_goal']} with an axis "
+                  f">= {100 * d['goal_m']:g} cm; worst N / E / D {' / '.join(f'{100 * v:.1f}' for v in d['worst_m'])} cm, "
+                  f"mean {' / '.join(f'{100 * v:.1f}' for v in d['mean_m'])} cm")
         elif part == "system":
             from .bench_system import whole_system
 

@@ -31,7 +31,7 @@ from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.logging import addLoggerProxy
 
 DT = 0.05                  # s, communication step of every case (20 Hz)
-RECORD_STEPS = 9400        # 470 s of VesselMotion output: warm-up + a 5-minute GNSS dropout + recovery
+RECORD_STEPS = 10600       # 530 s of VesselMotion output: 190 s warm-up + a 5-minute GNSS dropout + recovery
 OK, WARNING, DISCARD, ERROR, FATAL = range(5)
 FMUS = ("VesselMotion", "AttitudeEstimator", "DisplacementReconstructor", "GnssAccFusion", "CentreOfRotation",
         "HeaveObserver", "AhcWinch", "AhcController")
@@ -396,13 +396,15 @@ def _gnss_disturbance(name: str, fmu_dir: Path, work: Path, start_k: int, steps:
 
 
 def case_gnss_dropout(name: str, fmu_dir: Path, work: Path) -> dict:
-    """A 5-minute GNSS dropout (gnss.valid false) 130 s into the run (the wave coast is ready)."""
-    return _gnss_disturbance(name, fmu_dir, work, 2600, 6000, 0.0)
+    """A 5-minute GNSS dropout (gnss.valid false) 190 s into the run (the wave coast is ready:
+    its spectrum window, wave_coast.SPECTRUM_WINDOW, is 180 s)."""
+    return _gnss_disturbance(name, fmu_dir, work, 3800, 6000, 0.0)
 
 
 def case_gnss_jump(name: str, fmu_dir: Path, work: Path) -> dict:
-    """A 65 m jump north of every antenna for 20 s, 130 s into the run."""
-    return _gnss_disturbance(name, fmu_dir, work, 2600, 400, 65.0)
+    """A 65 m jump north of every antenna for 20 s, 190 s into the run (the wave coast is
+    ready, as for the dropout)."""
+    return _gnss_disturbance(name, fmu_dir, work, 3800, 400, 65.0)
 
 
 def case_step_sizes(name: str, fmu_dir: Path, work: Path) -> dict:
