@@ -410,6 +410,9 @@ class GnssAccFusion:
         self.residual = 0.0
         self.acc_n = np.zeros(3)
         self.coaster = WaveCoast(p.coast_window) if p.coast == "band" else None
+        # the coast corrects its acceleration with its own attitude (coast_attitude_tau) when
+        # there is a correction and a gyro-propagated attitude; otherwise it takes acc_n
+        self.coast_attitude = self.coaster is not None and p.attitude_correction and p.propagation == "gyro"
         self.since_pseudo = 0.0  # time since the last wave-model pseudo-fix [s]
 
     # ---- per step ----------------------------------------------------------------------------
@@ -447,7 +450,7 @@ class GnssAccFusion:
         if p.propagation == "gyro" and w is not None:
             w_step = w if p.step_input == "latest" else 0.5 * (w_prev + w)
             self.q = propagate(self.q, w_step - self.gyro_bias, dt)
-            if self.coaster is not None:
+            if self.coast_attitude:
                 self.q_coast = propagate(self.q_coast, w_step - self.coast_bias, dt)
         rot = quat_to_rot(self.q)
         start = self.acc_n if self.initialised else None  # a_n at the start of the step
@@ -464,8 +467,7 @@ class GnssAccFusion:
             self.kf.predict(u=u.reshape(3, 1))
             self.prior = (self.kf.x.copy(), self.kf.P.copy())
         if self.coaster is not None and self.initialised:
-            own = p.attitude_correction and p.propagation == "gyro"
-            self.coaster.add(quat_to_rot(self.q_coast) @ f_b + GRAVITY_N if own else self.acc_n, dt)
+            self.coaster.add(quat_to_rot(self.q_coast) @ f_b + GRAVITY_N if self.coast_attitude else self.acc_n, dt)
         fix = ""
         if gnss is not None:
             fix, why = self._epoch(gnss, dt)
@@ -517,7 +519,7 @@ class GnssAccFusion:
         if self.coaster is not None:
             self.coaster.anchor(z)
         self._correct_attitude(sol.rot, min(self.since_fix, 1e9))
-        if self.coaster is not None and p.propagation == "gyro":
+        if self.coast_attitude:
             self.q_coast, self.coast_bias = pi_pull(self.q_coast, self.coast_bias, sol.rot, min(self.since_fix, 1e9),
                                                     p.coast_attitude_tau)
         self.since_fix = 0.0

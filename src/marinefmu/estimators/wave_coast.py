@@ -150,7 +150,7 @@ class WaveCoast:
     def ready(self) -> bool:
         """The band observers have had their first spectrum (an axis without band energy has
         no wave model and only the drift)."""
-        return self.dt is not None and self.k * self.dt >= self.observers[0].params.window
+        return self.dt is not None and self.k * self.dt >= self.spectrum_window
 
     def _lead(self) -> float:
         """Time since the end of the last block [s]."""
