@@ -113,11 +113,11 @@ FUSION_PARAMETERS: list[Variable] = [
     real("bias_rw", _FU.bias_rw, "m/s2/sqrt(s)", "Random-walk density of the bias states, (0, 10]"),
     real("max_residual", _FU.max_residual, "m", "Largest RMS antenna-fit residual of a usable fix, > 0"),
     real("reinit_time", _FU.reinit_time, "s", "Re-initialise on GNSS after rejecting fixes this long, > 0"),
-    real("max_coast", _FU.max_coast, "s", "valid goes false this long after the last accepted fix, > 0"),
+    real("max_coast", _FU.max_coast, "s", "valid goes false this long after the last accepted fix (and without a coast the position is held), > 0"),
     Variable("coast", "string", _FU.coast, "", f"Through a GNSS gap: one of {', '.join(COAST_CHOICES)} (wave-model pseudo-fixes for a vessel on station or moving steadily, or prediction only)"),
     real("coast_sigma", _FU.coast_sigma, "m", "Standard deviation of a wave-model pseudo-fix, (0, 10]"),
     real("coast_attitude_tau", _FU.coast_attitude_tau, "s", "Time constant of the coast's own PI attitude (coast = band, propagation = gyro), 0.1..10000"),
-    real("coast_window", _FU.coast_window, "s", "Memory of the drift model of coast = band and the longest gap it bridges, 10..3600"),
+    real("coast_window", _FU.coast_window, "s", "Memory of the drift model of coast = band, 10..3600"),
 ]
 FUSION_INPUTS: list[Variable] = [
     *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),
@@ -129,7 +129,7 @@ FUSION_INPUTS: list[Variable] = [
 FUSION_OUTPUTS: list[Variable] = [
     *vec("pos", "ned", 0.0, "m", "Fused COG position, NED"),
     *vec("vel", "ned", 0.0, "m/s", "Fused COG velocity, NED"),
-    *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (filter covariance), NED"),
+    *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (filter covariance, plus the wave coast's own in a gap), NED"),
     real("roll", 0.0, "rad", "Roll used for the correction (antennas, gyro-propagated)"),
     real("pitch", 0.0, "rad", "Pitch used for the correction"),
     real("yaw", 0.0, "rad", "Yaw used for the correction"),

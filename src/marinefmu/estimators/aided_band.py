@@ -208,6 +208,13 @@ class AidedBand:
         """Position of the axis [m] ``lead`` s after the band states' time (moved on by the rate)."""
         return float(self._row(lead) @ self.x)
 
+    def std(self, lead: float) -> tuple[float, float]:
+        """Standard deviations of :meth:`position` [m] and of the axis velocity [m/s] from the
+        covariance."""
+        h = self._row(lead)
+        v = self.rows[1]
+        return math.sqrt(max(0.0, float(h @ self.P @ h))), math.sqrt(max(0.0, float(v @ self.P @ v)))
+
     def _row(self, lead: float) -> np.ndarray:
         return self.rows[0] + lead * self.rows[1]
 

@@ -37,9 +37,10 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    Beyond the paper: an n-frame accelerometer-bias state per axis (``bias_states``; random
    walk of density ``bias_rw``), which also absorbs slowly varying tilt errors; a Mahalanobis
    gate on the 3-D innovation (``gate`` in σ) that rejects jumps and outliers; coasting
-   (prediction only) through dropouts, with ``valid`` false after ``max_coast`` s;
+   through dropouts (item 4), with ``valid`` false after ``max_coast`` s;
    re-initialisation on GNSS after ``reinit_time`` s of consecutive rejections (a real
-   reposition, not a glitch) and on the first fix after a gap longer than ``max_coast``; and
+   reposition, not a glitch) and on the first fix after a gap longer than ``max_coast`` (with
+   the velocity the wave coast held, when it bridged the gap); and
    an RTS fixed-interval smoother for post-processing (:func:`fuse`, ``smooth=True``;
    hand-written because filterpy's ``rts_smoother`` has no control input, and here
    x⁻_{k+1} = Φ x_k + G u_k).
@@ -51,8 +52,14 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    straight line through the gap. Once no fix has come for :data:`COAST_AFTER` s, the
    position of :class:`~.wave_coast.WaveCoast` (per axis, the band observer's wave model and a
    drift in one Kalman filter that the fixes update too, :mod:`.aided_band`) updates the filter every
-   :data:`COAST_INTERVAL` s as a pseudo-fix of standard deviation ``coast_sigma`` (not gated;
-   ``fix`` is ``"wave"``). Measured on the paper's set-up (1 Hz, 30 s dropout, seeds 1-3): see the README.
+   :data:`COAST_INTERVAL` s as a pseudo-fix (not gated; ``fix`` is ``"wave"``) of variance
+   ``coast_sigma``² plus the coast's own (which grows through the gap), until GNSS returns,
+   however long the gap: on the paper's set-up a 5-min gap errs 23 cm at most (seeds 1-2),
+   where the inertial coast is kilometres off. ``pos_std`` includes the coast's variance, and
+   it goes back into the filter's covariance before the next fix is gated. Without a coast
+   position for ``max_coast`` s (``"inertial"``, or a gap in the coast's first 3 minutes) the
+   filter holds its position (velocity zero) until GNSS returns. Measured on the paper's
+   set-up (1 Hz, 30 s dropout, seeds 1-3): see the README.
 """
 from __future__ import annotations
 
@@ -139,7 +146,8 @@ class FusionParams:
         [``reinit_time``]
     max_coast : float
         ``valid`` goes false this long [s] after the last accepted fix, and the first fix after
-        such a gap re-initialises the filter, > 0. [``max_coast``]
+        such a gap re-initialises the filter; without a coast position for this long the
+        position is held, > 0. [``max_coast``]
     coast : {"band", "inertial"}
         Through a GNSS gap: wave-model pseudo-fixes (a vessel on station or moving steadily)
         or prediction only (module docstring). [``coast``]
@@ -158,9 +166,10 @@ class FusionParams:
         and 1000 s (6.9 cm, 10.7 cm). The fusion's own 60 s would coast as well but
         makes the fused output worse all the time (README, paper 001). [``coast_attitude_tau``]
     coast_window : float
-        Memory of the drift model of ``coast="band"`` (:func:`~.aided_band.drift_noise`), and
-        the longest time after the last fix that it still gives pseudo-fixes [s], 10 … 3600.
-        The coast has no position before its spectrum window
+        Memory of the drift model of ``coast="band"`` (:func:`~.aided_band.drift_noise`) [s],
+        10 … 3600. The coast gives pseudo-fixes until GNSS returns, however long the gap (until
+        2026-11-23 only for ``coast_window`` s, then the inertial coast took over and was
+        1.6 km off after a 5-min gap). It has no position before its spectrum window
         (:data:`~.wave_coast.SPECTRUM_WINDOW`, 180 s) has passed. [``coast_window``]
     """
 
@@ -340,7 +349,10 @@ def pi_pull(q: np.ndarray, bias: np.ndarray, rot_fix: np.ndarray, dt_fix: float,
     e_n = Rotation.from_matrix(rot_fix @ rot.T).as_rotvec()  # small rotation est → fix, NED
     alpha = min(1.0, 2.0 * dt_fix / tau)  # k_p = 2/τ
     q = quat_mul(quat_from_rotvec(alpha * e_n), q)
-    return q / np.linalg.norm(q), bias - (dt_fix / tau ** 2) * (rot.T @ e_n)  # k_i = 1/τ²
+    # k_i = 1/τ², its gain dt_fix/τ² capped at 1/dt_fix after a gap longer than τ: e_n/dt_fix is
+    # then the whole bias error that built e_n (after a 300 s gap at τ = 30 s the uncapped gain
+    # would correct it 100 times over)
+    return q / np.linalg.norm(q), bias - (dt_fix / max(tau, dt_fix) ** 2) * (rot.T @ e_n)
 
 
 def transition(dt: float, bias: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -414,6 +426,7 @@ class GnssAccFusion:
         # there is a correction and a gyro-propagated attitude; otherwise it takes acc_n
         self.coast_attitude = self.coaster is not None and p.attitude_correction and p.propagation == "gyro"
         self.since_pseudo = 0.0  # time since the last wave-model pseudo-fix [s]
+        self.coast_var: np.ndarray | None = None  # coast position variance at the last pseudo-fix [m²]
 
     # ---- per step ----------------------------------------------------------------------------
     def step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None) -> FusionResult:
@@ -459,7 +472,9 @@ class GnssAccFusion:
         self.since_fix += dt
         self.since_epoch += dt
         self.prior = None
-        if self.initialised:
+        if self.initialised and self._holding():
+            self.kf.x[3:6] = 0.0  # no fix and no coast for max_coast s: hold the position
+        elif self.initialised:
             if dt != self._model_dt:  # rebuilt only when the step size changes
                 self.kf.F, self.kf.B = transition(dt, p.bias_states)
                 self.kf.Q = process_noise(dt, p.q, p.bias_rw if p.bias_states else None, p.q_down)
@@ -495,17 +510,28 @@ class GnssAccFusion:
         # the propagated one is off by centiradians, decimetres over the arm.
         arm = np.asarray(p.acc_lever_arm) - p.arms.mean(axis=0)
         # after a gap longer than max_coast the output has been invalid for a while and the
-        # coasted velocity and attitude are not worth keeping (an update would pull the position
-        # but keep a metres-per-second velocity error, and gate out the next fixes)
+        # coasted attitude and accelerometer bias are not worth keeping (on the paper-001 set-up
+        # after 5 min: 20 mrad, and the bias states 0.08 m/s² off, took more than 40 s to
+        # settle), nor the velocity of an inertial coast (an update would pull the position but
+        # keep a metres-per-second error, and gate out the next fixes). The velocity that the
+        # wave coast held (0.2 m/s off at most) is kept: a restart at rest errs 30-40 cm in the
+        # first seconds.
         restart = not self.initialised or self.since_fix > p.max_coast
         rot_arm = sol.rot if p.propagation == "hold" or restart else quat_to_rot(self.q)
         z = sol.centroid + rot_arm @ arm
         r_meas = np.eye(3) * (p.r / dt)  # eq. 17
         if restart:
             gap_s, first = self.since_fix, not self.initialised
-            self._initialise(sol, z, r_meas)
+            bridged = not first and self.since_pseudo <= p.max_coast
+            self._initialise(sol, z, r_meas, bridged)
             return "accepted", None if first else (f"GNSS back after {gap_s:.0f} s without a fix (> max_coast): "
-                                                   "filter re-initialised on GNSS")
+                                                   "filter re-initialised on GNSS" +
+                                                   (", velocity kept from the wave coast" if bridged else ""))
+        if self.coast_var is not None:
+            # the pseudo-fixes' error is one slowly growing error, which the filter took as
+            # independent samples: its covariance goes back in before GNSS is weighed again
+            self.kf.P[:3, :3] += np.diag(self.coast_var)
+            self.coast_var = None
         y = z - self.kf.H @ self.kf.x.ravel()
         s = self.kf.H @ self.kf.P @ self.kf.H.T + r_meas
         d = math.sqrt(float(y @ np.linalg.solve(s, y)))
@@ -526,6 +552,12 @@ class GnssAccFusion:
         self.rejecting = 0.0
         return "accepted", None
 
+    def _holding(self) -> bool:
+        """No accepted fix and no pseudo-fix for ``max_coast`` s: the position is held (an
+        inertial coast is kilometres off after minutes, and ``valid`` is false by then)."""
+        p = self.params
+        return self.since_fix > p.max_coast and self.since_pseudo > p.max_coast
+
     def _pseudo_fix(self, dt: float) -> bool:
         """In a GNSS gap, update the filter with the wave-model coast position once every
         :data:`COAST_INTERVAL` s (``coast="band"``); True if it did."""
@@ -537,22 +569,30 @@ class GnssAccFusion:
         z = self.coaster.position()
         if z is None:
             return False
-        self.kf.update(z, R=np.eye(3) * self.params.coast_sigma ** 2)
+        self.coast_var = self.coaster.position_std() ** 2
+        self.kf.update(z, R=np.diag(self.params.coast_sigma ** 2 + self.coast_var))
         self.since_pseudo = 0.0
         return True
 
-    def _initialise(self, sol: AntennaFix, z: np.ndarray, r_meas: np.ndarray) -> None:
+    def _initialise(self, sol: AntennaFix, z: np.ndarray, r_meas: np.ndarray, keep_velocity: bool = False) -> None:
+        """Start the filter on a fix: position ``z``, velocity 0 ± 1 m/s or (``keep_velocity``)
+        the coasted one with its variance plus the wave coast's, bias 0 ± 0.01 m/s²."""
         p = self.params
+        nx = self.kf.dim_x
+        var = np.array([r_meas[0, 0]] * 3 + [1.0] * 3 + ([1e-4] * 3 if p.bias_states else []))
+        x = np.zeros((nx, 1))
+        x[:3, 0] = z
+        if keep_velocity:
+            x[3:6] = self.kf.x[3:6]
+            var[3:6] = np.diag(self.kf.P)[3:6] + self.coaster.velocity_std() ** 2
         if self.coaster is not None:
             self.coaster.forget_position()
-        nx = self.kf.dim_x
         self.prior = None  # a restart: nothing to smooth across
-        self.kf.x = np.zeros((nx, 1))
-        self.kf.x[:3, 0] = z
-        var = [r_meas[0, 0]] * 3 + [1.0] * 3 + ([1e-4] * 3 if p.bias_states else [])  # v ±1 m/s, b ±0.01 m/s²
+        self.kf.x = x
         self.kf.P = np.diag(var)
         self.q = Rotation.from_matrix(sol.rot).as_quat(scalar_first=True)
         self.q_coast = self.q.copy()
+        self.coast_var = None
         self.initialised = True
         self.since_fix = 0.0
         self.rejecting = 0.0
@@ -574,7 +614,8 @@ class GnssAccFusion:
         vel = x[3:6].copy()
         if w is not None and self.initialised:
             vel -= rot @ cross3(w - self.gyro_bias, p.acc_lever_arm)
-        std = np.sqrt(np.diag(self.kf.P)[:3]) if self.initialised else np.zeros(3)  # valid is False then
+        var = np.diag(self.kf.P)[:3] + (0.0 if self.coast_var is None else self.coast_var)  # with the coast's own
+        std = np.sqrt(var) if self.initialised else np.zeros(3)  # valid is False then
         bias = x[6:9] if p.bias_states else np.zeros(3)
         euler = quat_to_euler(self.q)
         return FusionResult(tuple(pos.tolist()), tuple(vel.tolist()), tuple(std.tolist()), tuple(euler),
@@ -590,6 +631,7 @@ class GnssAccFusion:
             "last_gyro": None if self.last_gyro is None else self.last_gyro.tolist(), "since_fix": self.since_fix, "rejecting": self.rejecting,
             "residual": self.residual, "acc_n": self.acc_n.tolist(),
             "since_epoch": self.since_epoch, "since_pseudo": self.since_pseudo,
+            "coast_var": None if self.coast_var is None else self.coast_var.tolist(),
             "coaster": None if self.coaster is None else self.coaster.get_state(),
         }
 
@@ -605,6 +647,7 @@ class GnssAccFusion:
         self.residual, self.acc_n = float(s["residual"]), np.array(s["acc_n"])
         self.since_epoch = float(s["since_epoch"])
         self.since_pseudo = float(s["since_pseudo"])
+        self.coast_var = None if s["coast_var"] is None else np.array(s["coast_var"])
         if self.coaster is not None:
             self.coaster.set_state(s["coaster"])
 
