@@ -54,7 +54,7 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    drift in one Kalman filter that the fixes update too, :mod:`.aided_band`) updates the filter every
    :data:`COAST_INTERVAL` s as a pseudo-fix (not gated; ``fix`` is ``"wave"``) of variance
    ``coast_sigma``² plus the coast's own (which grows through the gap), until GNSS returns,
-   however long the gap: on the paper's set-up a 5-min gap errs 23 cm at most (seeds 1-2),
+   however long the gap: on the paper's set-up a 5-min gap errs 23 cm at most (seeds 1-4),
    where the inertial coast is kilometres off. ``pos_std`` includes the coast's variance, and
    it goes back into the filter's covariance before the next fix is gated. Without a coast
    position for ``max_coast`` s (``"inertial"``, or a gap in the coast's first 3 minutes) the

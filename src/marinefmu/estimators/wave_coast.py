@@ -174,9 +174,9 @@ class WaveCoast:
     def position(self) -> np.ndarray | None:
         """Coast position of the accelerometer point now [m, NED], or None before the first
         spectrum or before :data:`MIN_FIXES` fixes. However long ago the last fix was: the
-        error grows slowly (5-min gaps of the paper-001 set-up, seeds 1-2: at most 18 / 26 cm
-        over the gap, :meth:`position_std` 18 cm at its end), where the inertial coast is off
-        by kilometres (README)."""
+        error grows slowly (the fused output through 5-min gaps of the paper-001 set-up, seeds
+        1-4: at most 23 cm; :meth:`position_std` 18 cm at the end), where the inertial coast
+        is off by kilometres (README)."""
         if not self.ready or self.k_fix is None or min(b.fixes for b in self.bands) < MIN_FIXES:
             return None
         lead = self._lead()

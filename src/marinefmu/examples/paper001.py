@@ -230,6 +230,10 @@ DROPOUTS = tuple((s, seed) for s in (270.0, 300.0, 320.0) for seed in range(1, 1
     tuple((400.0, seed) for seed in range(11, 21))
 
 
+#: Five-minute dropouts (start [s], seed), bridged by the wave coast (README): at 270 s of seeds 1-4.
+LONG_DROPOUTS = tuple((270.0, seed) for seed in range(1, 5))
+
+
 def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict:
     """The fused real-time COG through a ``duration`` s GNSS dropout (1 Hz RTK, wave-model
     coast) for each (start, seed) of ``cases``: the largest error per axis [m] in the gap.
