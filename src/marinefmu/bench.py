@@ -147,8 +147,9 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
 PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "system", "ahc", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
-#: Seas of the heave accuracy part (paper 003 checks, Hs [m], Tp [s]; Hs 4 / Tp 12 and Hs 2.5 / Tp 14 are no test's seas: they
-#: show where in the issue's Tp 6-14 s range the goal stops holding).
+#: Seas of the heave accuracy part (paper 003 checks, Hs [m], Tp [s]; Hs 4 / Tp 12 and
+#: Hs 2.5 / Tp 14 are no test's seas: they show where in the issue's Tp 6-14 s range the goal
+#: stops holding).
 HEAVE_SEAS = ((1.0, 6.0), (4.0, 6.0), (2.5, 9.0), (4.0, 12.0), (1.0, 14.0), (2.5, 14.0), (4.0, 14.0))
 
 

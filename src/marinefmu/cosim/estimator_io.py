@@ -212,7 +212,7 @@ HEAVE_PARAMETERS: list[Variable] = [
     Variable("model", "string", _HV.model, "", f"Observer model: one of {', '.join(MODEL_CHOICES)} (spectrum-weighted comb of band-pass elements, the paper's undamped modes at the peaks, or the classical high-pass double integration as a baseline)"),
     Variable("max_modes", "integer", _HV.max_modes, "", "Most oscillator modes (model = peaks), 1..20"),
     Variable("elements", "integer", _HV.elements, "", "Grid size of the band model, 2..100"),
-    real("band_min", _HV.band_min, "rad/s", "Lowest band element (model = band; lower it for swell longer than 14 s), (0, omega_max)"),
+    real("band_min", _HV.band_min, "rad/s", "Lowest band element (model = band; lower it for swell longer than about 16 s), (0, omega_max)"),
     real("damping", _HV.damping, "", "Damping ratio of the band elements' stages, (0, 1]"),
     Variable("stages", "integer", _HV.stages, "", "Cascaded oscillators per band element, 1..4"),
     real("spectrum_floor", _HV.spectrum_floor, "", "Band elements below this fraction of the highest heave density are left out, [0, 1)"),
