@@ -10,7 +10,7 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 - ``in_process``: ``VesselMotionModel.step`` without FMI;
 - ``system_runner``: the FMPy system master recording every output.
 
-Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_accuracy`),
+Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_accuracy`) and its ``band_min`` study,
 marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
 (``orcaflex``), the GNSS dropout coast of paper 001 over 40 dropouts (``dropout``,
 :func:`marinefmu.examples.paper001.dropouts`), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
@@ -204,6 +204,20 @@ def heave_accuracy() -> dict[str, dict]:
     return result
 
 
+def heave_band_min() -> dict[str, dict]:
+    """The heave observer's ``band_min`` study (:func:`marinefmu.examples.paper003.band_min_study`),
+    printed: RMS error at the IMU [cm] (and below 0.2 rad/s) per case and ``band_min``."""
+    from .examples import paper003
+
+    result = paper003.band_min_study()
+    for case, by_value in result.items():
+        print(f"heave band_min, {case}: " + "; ".join(
+            f"{b} rad/s {r['rms_cm']:.2f} cm" + (f" ({r['below_0.2_rad_s_cm']:.2f} below 0.2 rad/s)"
+                                                 if "below_0.2_rad_s_cm" in r else "")
+            for b, r in by_value.items()), flush=True)
+    return result
+
+
 def peer_comparison(duration: float = 600.0) -> dict[str, dict]:
     """marinefmu beside smsfusion on the same records (:mod:`marinefmu.peer`) over
     :data:`PEER_SEAS`: the ``system`` scenario's vessel, heading, IMU position and 5 Hz GNSS,
@@ -244,7 +258,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     part keeps its own date and machine, so parts can be re-measured one at a time) and print
     what they measure; return the whole file's data.
 
-    ``speed`` takes a few minutes, ``heave`` about five, ``peer`` about one, ``orcaflex`` a
+    ``speed`` takes a few minutes, ``heave`` about thirteen (seven seas and the ``band_min`` study), ``peer`` about one, ``orcaflex`` a
     few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 40 GNSS dropouts of 30 s and 4 of 5 min) about five, ``system`` (three seas, three engines and a 3-hour run) about an hour,
     ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
     2-core machine."""
@@ -267,7 +281,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
         if part == "speed":
             data.update(speed(fmu_dir, steps), **stamp)  # the speed figures stay at the top level
         elif part == "heave":
-            data["heave"] = {**stamp, "seas": heave_accuracy()}
+            data["heave"] = {**stamp, "seas": heave_accuracy(), "band_min": heave_band_min()}
         elif part == "peer":
             data["peer"] = {**stamp, "seas": peer_comparison()}
         elif part == "orcaflex":

@@ -37,6 +37,7 @@ import math
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -153,17 +154,29 @@ def attitude_runs(rec: OrcaflexRecord) -> dict[str, np.ndarray]:
     return runs
 
 
-def heave_run(rec: OrcaflexRecord, roll: np.ndarray, pitch: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Heave [m, down] and ``valid`` of marinefmu's HeaveObserver fed by ``roll``/``pitch``."""
+def heave_run(rec: OrcaflexRecord, roll: np.ndarray, pitch: np.ndarray,
+              **params: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Heave [m, down] and ``valid`` of marinefmu's HeaveObserver fed by ``roll``/``pitch``
+    (``params``: more :class:`~.estimators.heave.HeaveObserverParams` fields)."""
     from .estimators.heave import HeaveObserver, HeaveObserverParams
 
-    obs = HeaveObserver(HeaveObserverParams(acc_noise=sensor_noise(rec)[0]), quiet=True)
+    obs = HeaveObserver(HeaveObserverParams(acc_noise=sensor_noise(rec)[0], **params), quiet=True)
     heave = np.empty(len(rec.acc))
     valid = np.empty(len(rec.acc), dtype=bool)
     for k in range(len(rec.acc)):
         r = obs.step(rec.acc[k], float(roll[k]), float(pitch[k]), rec.dt)
         heave[k], valid[k] = r.heave, r.valid
     return heave, valid
+
+
+def heave_scores(rec: OrcaflexRecord, roll: np.ndarray, pitch: np.ndarray, **params: Any) -> dict[str, float]:
+    """Heave RMS error and true heave std [cm] of :func:`heave_run`, from the sample where the
+    observer turns valid (``from_s``)."""
+    heave, valid = heave_run(rec, roll, pitch, **params)
+    kv = int(np.argmax(valid)) if valid.any() else len(valid)
+    truth_d = rec.pos[:, 2] - rec.pos[:, 2].mean()
+    return {"heave_cm": 100.0 * float(_rms(heave[kv:] - truth_d[kv:])),
+            "heave_std_cm": 100.0 * float(np.std(truth_d[kv:])), "from_s": kv * rec.dt}
 
 
 def rotate_to_ned(acc: np.ndarray, roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.ndarray:
@@ -230,11 +243,7 @@ def compare_orcaflex(rec: OrcaflexRecord | None = None) -> dict[str, dict[str, f
         e = np.degrees(_rms(rp[k0:] - rec.euler[k0:, :2]))
         out[name] = {"roll_deg": float(e[0]), "pitch_deg": float(e[1])}
     roll, pitch = att["marinefmu AttitudeEstimator"].T
-    heave, valid = heave_run(rec, roll, pitch)
-    kv = int(np.argmax(valid)) if valid.any() else len(valid)
-    truth_d = rec.pos[:, 2] - rec.pos[:, 2].mean()
-    out["marinefmu HeaveObserver"] = {"heave_cm": 100.0 * float(_rms(heave[kv:] - truth_d[kv:])),
-                                      "heave_std_cm": 100.0 * float(np.std(truth_d[kv:])), "from_s": kv * rec.dt}
+    out["marinefmu HeaveObserver"] = heave_scores(rec, roll, pitch)
     f_n = rotate_to_ned(rec.acc, roll, pitch, rec.heading)
     fix = np.arange(len(rec.acc)) % FIX_EVERY == 0
     fix[:k0] = False

@@ -31,10 +31,13 @@ IMU, ARM = (-5.0, 1.0, -3.0), (40.0, 0.0, -5.0)
 HP_CUTOFFS = (0.05, 0.1, 0.2)
 
 
-def record(hs: float, tp: float, duration: float = 1920.0, seed: int = 3) -> dict[str, np.ndarray]:
-    """VesselMotion record of the checks (30 min after 2 min at the default duration)."""
+def record(hs: float, tp: float, duration: float = 1920.0, seed: int = 3,
+           extra: dict | None = None) -> dict[str, np.ndarray]:
+    """VesselMotion record of the checks (30 min after 2 min at the default duration);
+    ``extra``: more VesselMotion parameters (e.g. ``{"imu.acc_noise": 0.0}``)."""
     flat = {"sea.hs": hs, "sea.tp": tp, "sea.seed": seed, "sea.heading": 0.75 * math.pi,
-            **{f"imu.{a}": v for a, v in zip("xyz", IMU)}, **{f"point.{a}": i + r for a, i, r in zip("xyz", IMU, ARM)}}
+            **{f"imu.{a}": v for a, v in zip("xyz", IMU)}, **{f"point.{a}": i + r for a, i, r in zip("xyz", IMU, ARM)},
+            **(extra or {})}
     return simulate_record(VesselMotionParams.from_flat(flat), duration, DT)
 
 
@@ -78,6 +81,37 @@ def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
     runs["high-pass"] = hp
     return {"sea": (hs, tp), "t": (np.arange(len(a_imu)) + 1) * DT, "truth": truth, "runs": runs,
             "std_imu": float(np.std(truth["imu"][k0:])), "std_point": float(np.std(truth["point"][k0:]))}
+
+
+#: The accelerometer's noise and bias switched off in VesselMotion (:func:`band_min_study`).
+PERFECT_ACCELEROMETER = {"imu.acc_noise": 0.0, "imu.acc_bias_instability": 0.0}
+
+
+def band_min_study(values: tuple[float, ...] = (0.25, 0.3, 0.35), duration: float = 1920.0) -> dict:
+    """Real-time heave RMS error at the IMU [cm] against ``band_min`` (the band model's lowest
+    element, :class:`~marinefmu.estimators.heave.HeaveObserverParams`), and how much of it lies
+    below 0.2 rad/s: on the Tp 14 s seas of the checks, on Hs 4 / Tp 14 with the accelerometer's
+    noise and bias off (:data:`PERFECT_ACCELEROMETER`), and on smsfusion's OrcaFlex record
+    (true roll and pitch, :func:`marinefmu.peer_orcaflex.heave_scores`)."""
+    from scipy import signal
+
+    from ..peer_orcaflex import heave_scores, load_orcaflex
+
+    def errors(rec: dict, band_min: float) -> dict[str, float]:
+        out, _ = run_observer(HeaveObserverParams(point=ARM, band_min=band_min), rec)
+        k0 = int(SETTLE / DT)
+        e = out[k0:, 0] - (rec["truth.imu.d"][k0:] - rec["truth.imu.d"][k0:].mean())
+        f, psd = signal.welch(e, fs=1.0 / DT, nperseg=8192)
+        low = 2.0 * math.pi * f < 0.2
+        return {"rms_cm": 100.0 * _rms(e), "below_0.2_rad_s_cm": 100.0 * math.sqrt(float(np.sum(psd[low])) * f[1])}
+
+    cases = {"Hs 4 Tp 14": record(4.0, 14.0, duration), "Hs 1 Tp 14": record(1.0, 14.0, duration),
+             "Hs 4 Tp 14, perfect accelerometer": record(4.0, 14.0, duration, extra=PERFECT_ACCELEROMETER)}
+    result: dict = {name: {f"{b:g}": errors(rec, b) for b in values} for name, rec in cases.items()}
+    orca = load_orcaflex()
+    result["OrcaFlex, true angles"] = {
+        f"{b:g}": {"rms_cm": heave_scores(orca, orca.euler[:, 0], orca.euler[:, 1], band_min=b)["heave_cm"]} for b in values}
+    return result
 
 
 def plot(result: dict, path: str | Path) -> None:
