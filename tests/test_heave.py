@@ -14,9 +14,10 @@ from marinefmu.estimators.fixed_lag import FixedLagOutputs
 from marinefmu.estimators.heave import (
     HeaveObserver, HeaveObserverParams, point_heave, vertical_acceleration,
 )
-from marinefmu.estimators.band_bank import build_band_bank, discretise, resonator
+from marinefmu.estimators.band_bank import band_elements, band_grid, build_band_bank, discretise, resonator
 from marinefmu.estimators.oscillator_bank import build_bank, carry_map, mode_noise_covariance, mode_transition
 from marinefmu.frames import G, body_to_euler_rates
+from marinefmu.estimators.wave_peaks import Spectrum
 from marinefmu.sea.motion_model import stack
 from marinefmu.sea.waves import SeaState, realise
 
@@ -183,6 +184,49 @@ def test_band_min_is_the_lowest_band_element():
     assert lowest[0.25] == pytest.approx(0.25, rel=1e-12)
 
 
+def test_band_elements_integrate_the_heave_spectrum_over_their_bands():
+    """Each element's variance is the heave spectrum integrated over its band (between the
+    geometric midpoints of its neighbours), each periodogram bin spread evenly over its width:
+    one bin's heave variance lands on the elements its width overlaps, in proportion, and the
+    elements together hold exactly the variance of the bins inside the band."""
+    d = 0.01
+    omega = d * np.arange(1, 301)                      # bins 0.01 … 3 rad/s
+    grid = band_grid(0.3, 1.2, 9)
+    mid = np.sqrt(grid[1:] * grid[:-1])
+    k = 45                                             # bin at 0.46 rad/s, [0.455, 0.465]
+    acc = np.zeros_like(omega)
+    acc[k] = 2.0 * omega[k] ** 4                       # S_z = 2 m²/(rad/s) on that bin: 0.02 m²
+    spectrum = Spectrum(omega, acc, acc, acc, acc)
+    w, var = band_elements(spectrum, grid, 0.0)
+    edge = mid[np.searchsorted(mid, omega[k])]          # the one element boundary inside the bin
+    assert edge == pytest.approx(0.4627, abs=1e-4)
+    np.testing.assert_allclose(var, 2.0 * np.array([edge - 0.455, 0.465 - edge]), rtol=1e-9)
+    np.testing.assert_allclose(w, grid[[2, 3]], rtol=1e-12)
+    rng = np.random.default_rng(5)
+    acc = rng.uniform(0.1, 1.0, len(omega)) * omega ** 4
+    acc[(omega < 0.35) | (omega > 1.15)] = 0.0         # all energy inside the band
+    _, var = band_elements(Spectrum(omega, acc, acc, acc, acc), grid, 0.0)
+    assert var.sum() == pytest.approx(np.sum(acc / omega ** 4) * d, rel=1e-12)
+
+
+def test_spectrum_window_grows_with_the_data_up_to_window_max():
+    """The spectrum is taken over every sample so far, from ``window`` up to ``window_max``
+    seconds (the paper's fixed sliding window when they are equal)."""
+    dt = 0.5
+    t = dt * np.arange(1, 801)
+    f_z = -G - 0.5 * np.sin(0.7 * t)
+    lengths = {}
+    for window_max in (60.0, 200.0):
+        obs = HeaveObserver(HeaveObserverParams(window=60.0, window_max=window_max))
+        seen = []
+        for k, f in enumerate(f_z, start=1):
+            obs.step(f, 0.0, 0.0, dt)
+            if k in (120, 300, 800):
+                seen.append(len(obs._window()) * dt)
+        lengths[window_max] = seen
+    assert lengths == {60.0: [60.0, 60.0, 60.0], 200.0: [60.0, 150.0, 200.0]}
+
+
 def test_carry_map_of_band_elements_keeps_heave_and_rate():
     old = build_band_bank(np.array([0.4, 0.5, 0.6]), np.array([0.1, 0.2, 0.1]), 0.05, 0.1, 3, 1e-4, 7e-4)
     new = build_band_bank(np.array([0.45, 0.6]), np.array([0.2, 0.1]), 0.05, 0.1, 3, 1e-4, 7e-4)
@@ -346,6 +390,7 @@ def test_bad_samples_coast_and_are_reported():
 
 @pytest.mark.parametrize("field,value,message", [
     ("window", 20.0, "window = 20.0 is out of range"),
+    ("window_max", 100.0, "window_max = 100.0 is out of range"),
     ("max_modes", 0, "max_modes = 0 is out of range"),
     ("acc_noise", 0.0, "acc_noise = 0.0 is out of range"),
     ("mode_noise", -1.0, "mode_noise = -1.0 is out of range"),

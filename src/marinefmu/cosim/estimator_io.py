@@ -207,7 +207,8 @@ def cr_params(values: dict[str, Any]) -> CentreOfRotationParams:
 
 _HV = HeaveObserverParams()
 HEAVE_PARAMETERS: list[Variable] = [
-    real("window", _HV.window, "s", "Spectrum window, >= two periods of omega_min (4 pi/omega_min), <= 3600"),
+    real("window", _HV.window, "s", "First spectrum window (valid after it), >= two periods of omega_min (4 pi/omega_min), <= 3600"),
+    real("window_max", _HV.window_max, "s", "Longest spectrum window: it grows with the data from window to this (= window: the paper's fixed window), [window, 3600]"),
     real("peak_interval", _HV.peak_interval, "s", "Time between peak detections (paper 003: T = 15 s), (0, 3600]"),
     Variable("model", "string", _HV.model, "", f"Observer model: one of {', '.join(MODEL_CHOICES)} (spectrum-weighted comb of band-pass elements, the paper's undamped modes at the peaks, or the classical high-pass double integration as a baseline)"),
     Variable("max_modes", "integer", _HV.max_modes, "", "Most oscillator modes (model = peaks), 1..20"),
@@ -262,7 +263,7 @@ def heave_params(values: dict[str, Any]) -> HeaveObserverParams:
     """HeaveObserverParams from FMI-named values."""
     v = resolve(HEAVE_PARAMETERS, values, "HeaveObserver")
     return HeaveObserverParams(
-        window=v["window"], peak_interval=v["peak_interval"], max_modes=v["max_modes"], omega_min=v["omega_min"],
+        window=v["window"], window_max=v["window_max"], peak_interval=v["peak_interval"], max_modes=v["max_modes"], omega_min=v["omega_min"],
         omega_max=v["omega_max"], min_separation=v["min_separation"], min_relative=v["min_relative"],
         model=v["model"], elements=v["elements"], band_min=v["band_min"], damping=v["damping"], stages=v["stages"],
         spectrum_floor=v["spectrum_floor"], acc_noise=v["acc_noise"], mode_noise=v["mode_noise"], offset_noise=v["offset_noise"],

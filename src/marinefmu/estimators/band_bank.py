@@ -88,23 +88,37 @@ def band_grid(omega_min: float, omega_max: float, count: int) -> np.ndarray:
 def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float) -> tuple[np.ndarray, np.ndarray]:
     """Elements of the band and their heave variances from an acceleration spectrum.
 
+    Element j covers the band between the geometric midpoints of its neighbours in ``grid``
+    (the end elements as far out as in), and its variance is the heave spectrum
+    S_z(ω) = S_ä(ω)/ω⁴ integrated over that band, each periodogram bin spread evenly over its
+    width. (Until 2026-11-23 it was S_z at ω_j times the element's width: one or two bins of a
+    periodogram, whose values scatter ±100 %; measured in :data:`~.heave.WINDOW_MAX`.)
+
     Parameters
     ----------
     spectrum : Spectrum
         From :func:`~.wave_peaks.acceleration_spectrum`.
     grid : numpy.ndarray
-        (M,) candidate frequencies [rad/s], ascending, M ≥ 2 (:func:`band_grid`).
+        (M,) candidate frequencies [rad/s], ascending, geometric, M ≥ 2 (:func:`band_grid`).
     floor : float
-        Elements whose heave density is below ``floor`` times the highest are left out.
+        Elements whose mean heave density over their band is below ``floor`` times the highest
+        are left out.
 
     Returns
     -------
     tuple of numpy.ndarray
         Frequencies [rad/s] and heave variances [m²] of the elements kept (possibly none).
     """
-    s_z = np.interp(grid, spectrum.omega, spectrum.acc_density) / grid**4
-    keep = (s_z > 0.0) & (s_z >= floor * s_z.max())
-    return grid[keep], (s_z * np.gradient(grid))[keep]
+    mid = np.sqrt(grid[1:] * grid[:-1])
+    lo = np.concatenate([[grid[0] ** 2 / mid[0]], mid])
+    hi = np.concatenate([mid, [grid[-1] ** 2 / mid[-1]]])
+    d_omega = spectrum.omega[1] - spectrum.omega[0]
+    edges = np.concatenate([spectrum.omega - 0.5 * d_omega, [spectrum.omega[-1] + 0.5 * d_omega]])
+    cumulative = np.concatenate([[0.0], np.cumsum(spectrum.acc_density / spectrum.omega**4) * d_omega])
+    variance = np.interp(hi, edges, cumulative) - np.interp(lo, edges, cumulative)
+    density = variance / (hi - lo)
+    keep = (density > 0.0) & (density >= floor * density.max())
+    return grid[keep], variance[keep]
 
 
 def build_band_bank(omega: np.ndarray, variance: np.ndarray, dt: float, damping: float, stages: int,

@@ -5,7 +5,10 @@ Heave (positive down, NED, relative to the mean position) is estimated from the 
 acceleration with no model of the craft, in the paper's four steps:
 
 1. **Spectrum** of the vertical acceleration over the last ``window`` seconds and the position
-   spectrum A(ω) = Ä(ω)/ω² (eq. 2), :func:`~.wave_peaks.acceleration_spectrum`.
+   spectrum A(ω) = Ä(ω)/ω² (eq. 2), :func:`~.wave_peaks.acceleration_spectrum`. Beyond the
+   paper, the window then grows with the data up to ``window_max`` seconds (``window_max =
+   window`` is the paper's fixed window): a longer record gives the band model a finer and
+   steadier spectrum (measured in :data:`WINDOW_MAX`).
 2. **Peaks** of A(ω) every ``peak_interval`` seconds (paper: T = 15 s) inside
    [``omega_min``, ``omega_max``], at most ``max_modes``, :func:`~.wave_peaks.find_modes`.
 3. **Observer**: ``model="peaks"`` is the paper's, a Kalman filter over undamped oscillator
@@ -91,6 +94,8 @@ TRANSFER_CHOICES = ("exact", "paper")
 #: Hs 4 / Tp 14 3.34-3.44 with band_min 0.25), four stages per element (3.80), offset noise
 #: 3e-5 / 5e-5 (4.57 / 4.02).
 BAND_MIN = 0.3
+#: Default longest spectrum window ``window_max`` [s] (:class:`HeaveObserverParams`).
+WINDOW_MAX = 600.0
 
 
 @dataclass(frozen=True)
@@ -100,8 +105,12 @@ class HeaveObserverParams:
     Parameters
     ----------
     window : float
-        Length of the spectrum window [s], at least two periods of ``omega_min``
-        (4π/omega_min) and at most 3600. [``window``]
+        Length of the first spectrum window [s] (the observer is valid after it), at least two
+        periods of ``omega_min`` (4π/omega_min) and at most 3600. [``window``]
+    window_max : float
+        Longest spectrum window [s], [window, 3600]: after the first spectrum the window takes
+        every sample so far up to this length (module docstring, :data:`WINDOW_MAX`); equal to
+        ``window`` for the paper's fixed sliding window. [``window_max``]
     peak_interval : float
         Time between peak detections [s], (0, 3600] (paper: T = 15 s). [``peak_interval``]
     model : str
@@ -164,6 +173,7 @@ class HeaveObserverParams:
     """
 
     window: float = 120.0
+    window_max: float = WINDOW_MAX
     peak_interval: float = 15.0
     model: str = "band"
     max_modes: int = 6
@@ -193,6 +203,7 @@ class HeaveObserverParams:
         check_range("omega_max", self.omega_max, lo=self.omega_min, hi=20.0, lo_open=True, unit="rad/s")
         shortest = 4.0 * math.pi / self.omega_min
         check_range("window", self.window, lo=shortest, hi=3600.0, unit="s (two periods of omega_min)")
+        check_range("window_max", self.window_max, lo=self.window, hi=3600.0, unit="s (at least window)")
         check_range("peak_interval", self.peak_interval, lo=0.0, hi=3600.0, lo_open=True, unit="s")
         check_choice("model", self.model, MODEL_CHOICES)
         check_int("max_modes", self.max_modes, lo=1, hi=20)
@@ -394,7 +405,7 @@ class HeaveObserver:
     def reset(self) -> None:
         """Back to the initial state."""
         self.dt: float | None = None
-        self.buf: np.ndarray | None = None     # (window samples, 4): a_v, roll, pitch, good
+        self.buf: np.ndarray | None = None     # ring of window_max samples × (a_v, roll, pitch, good)
         self.k = 0                              # samples seen
         self.next_detect = 0
         self.model: BankModel | None = None
@@ -414,7 +425,7 @@ class HeaveObserver:
         p = self.params
         self.dt = dt
         n = int(round(p.window / dt))
-        self.buf = np.zeros((n, 4))
+        self.buf = np.zeros((max(n, int(round(p.window_max / dt))), 4))
         self.next_detect = n
         self.smoother = FixedLagOutputs(int(round(p.smoother_lag / dt)), 2, 4)
 
@@ -516,8 +527,8 @@ class HeaveObserver:
         self.buf[(self.k - 1) % len(self.buf)] = row
 
     def _window(self) -> np.ndarray:
-        """The buffer, oldest first."""
-        return np.roll(self.buf, -(self.k % len(self.buf)), axis=0)
+        """The samples buffered so far (at most ``window_max`` s of them), oldest first."""
+        return np.roll(self.buf, -(self.k % len(self.buf)), axis=0)[-min(self.k, len(self.buf)):]
 
     def _detect(self) -> bool:
         """Steps 1-2 on the buffer and, if the band has energy, a new model with the state carried."""

@@ -106,7 +106,7 @@ class WaveCoast:
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
         vertical = HeaveObserverParams(smoother_lag=0.0, peak_interval=PEAK_INTERVAL, window=self.spectrum_window,
-                                       band_min=BAND_MIN)
+                                       window_max=self.spectrum_window, band_min=BAND_MIN)
         horizontal = replace(vertical, offset_noise=HORIZONTAL_OFFSET_NOISE)
         self.observers = [HeaveObserver(horizontal, quiet=True), HeaveObserver(horizontal, quiet=True),
                           HeaveObserver(vertical, quiet=True)]
