@@ -10,7 +10,7 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 - ``in_process``: ``VesselMotionModel.step`` without FMI;
 - ``system_runner``: the FMPy system master recording every output.
 
-Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_accuracy`) and its ``band_min`` study,
+Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_accuracy`, each beside its causal bound) and its ``band_min`` and ``window_max`` studies,
 marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
 (``orcaflex``), the GNSS dropout coast of paper 001 over 40 dropouts (``dropout``,
 :func:`marinefmu.examples.paper001.dropouts`), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
@@ -189,6 +189,7 @@ def heave_accuracy() -> dict[str, dict]:
     result = {}
     for hs, tp in HEAVE_SEAS:
         r = paper003.compare(hs, tp, duration=1920.0)
+        bound = paper003.causal_bound(hs, tp)
         runs = {label: {k: 100 * v for k, v in run.items() if k.startswith("rms_")} for label, run in r["runs"].items()}
         goal = {"real_time_imu": max(2.0, 2.5 * r["std_imu"]), "real_time_point": max(2.0, 2.5 * r["std_point"]),
                 "delayed": max(1.0, 1.0 * r["std_imu"])}  # [cm]: max(2 cm, 2.5 %), max(1 cm, 1 %) of the std in m
@@ -196,11 +197,23 @@ def heave_accuracy() -> dict[str, dict]:
         met = (band["rms_imu"] <= goal["real_time_imu"] and band["rms_point"] <= goal["real_time_point"]
                and band["rms_delayed"] <= goal["delayed"])
         result[f"Hs {hs:g} Tp {tp:g}"] = {"std_cm": [100 * r["std_imu"], 100 * r["std_point"]], "rms_cm": runs,
-                                          "goal_cm": goal, "met": met}
+                                          "goal_cm": goal, "met": met, "causal_bound_cm": bound["bound_cm"]}
         print(f"heave Hs {hs:g} m Tp {tp:g} s: band {band['rms_imu']:.2f} / {band['rms_point']:.2f} cm, delayed "
               f"{band['rms_delayed']:.2f} cm (goal {goal['real_time_imu']:.2f} / {goal['real_time_point']:.2f} / "
               f"{goal['delayed']:.2f} cm: {'met' if met else 'NOT met'}); paper's modes {runs['peaks (paper)']['rms_imu']:.2f} cm; "
-              f"high-pass {runs['high-pass']['rms_imu']:.2f} cm", flush=True)
+              f"high-pass {runs['high-pass']['rms_imu']:.2f} cm; causal bound at the IMU {bound['bound_cm']:.2f} cm",
+              flush=True)
+    return result
+
+
+def heave_window_max() -> dict[str, dict]:
+    """The heave observer's ``window_max`` study (:func:`marinefmu.examples.paper003.window_max_study`),
+    printed: RMS error at the IMU [cm] per case and ``window_max``."""
+    from .examples import paper003
+
+    result = paper003.window_max_study()
+    for case, by_value in result.items():
+        print(f"heave window_max, {case}: " + "; ".join(f"{w} s {cm:.2f} cm" for w, cm in by_value.items()), flush=True)
     return result
 
 
@@ -258,7 +271,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     part keeps its own date and machine, so parts can be re-measured one at a time) and print
     what they measure; return the whole file's data.
 
-    ``speed`` takes a few minutes, ``heave`` about thirteen (seven seas and the ``band_min`` study), ``peer`` about one, ``orcaflex`` a
+    ``speed`` takes a few minutes, ``heave`` about twenty (seven seas with their causal bounds, the ``band_min`` and ``window_max`` studies), ``peer`` about one, ``orcaflex`` a
     few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 40 GNSS dropouts of 30 s and 4 of 5 min) about five, ``system`` (three seas, three engines and a 3-hour run) about an hour,
     ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
     2-core machine."""
@@ -281,7 +294,8 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
         if part == "speed":
             data.update(speed(fmu_dir, steps), **stamp)  # the speed figures stay at the top level
         elif part == "heave":
-            data["heave"] = {**stamp, "seas": heave_accuracy(), "band_min": heave_band_min()}
+            data["heave"] = {**stamp, "seas": heave_accuracy(), "band_min": heave_band_min(),
+                             "window_max": heave_window_max()}
         elif part == "peer":
             data["peer"] = {**stamp, "seas": peer_comparison()}
         elif part == "orcaflex":
