@@ -186,25 +186,36 @@ def causal_bound(hs: float, tp: float, memory: float = 180.0, decimate: int = 8,
         ``taps``.
     """
     taps = int(round(memory / (decimate * DT)))
-
-    def rows(seed: int, length: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        rec = record(hs, tp, length, seed=seed, extra=extra)
-        a, z = vertical_record(rec), rec["truth.imu.d"]
-        n = len(a) // decimate * decimate
-        blocks = a[:n].reshape(-1, decimate).mean(axis=1)
-        x = np.lib.stride_tricks.sliding_window_view(blocks, taps)
-        ends = (np.arange(len(x)) + taps) * decimate - 1            # sample index of each estimate
-        return np.column_stack([x, np.ones(len(x))]), z[ends], ends * DT
-
-    normal, moment = 0.0, 0.0
-    for seed in train:
-        x, z, _ = rows(seed, train_duration)
-        normal, moment = normal + x.T @ x, moment + x.T @ z
-    w = np.linalg.solve(normal, moment)
-    x, z, t = rows(3, duration)
-    scored = t >= SETTLE
+    pairs = []
+    for seed in (*train, 3):
+        rec = record(hs, tp, train_duration if seed != 3 else duration, seed=seed, extra=extra)
+        pairs.append((vertical_record(rec), rec["truth.imu.d"]))
+    w = fit_causal_fir(pairs[:-1], taps, decimate)
+    x, z, ends = fir_rows(*pairs[-1], taps, decimate)
+    scored = ends * DT >= SETTLE
     e = x[scored] @ w - z[scored]
     return {"bound_cm": 100.0 * float(np.std(e)), "heave_std_cm": 100.0 * float(np.std(z[scored])), "taps": taps}
+
+
+def fir_rows(a: np.ndarray, z: np.ndarray, taps: int, decimate: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Regression rows of a causal FIR filter (:func:`causal_bound`): block means of ``a`` over
+    ``decimate`` samples, the last ``taps`` of them and a constant per row; the target ``z`` at
+    each block's last sample, and that sample's index."""
+    n = len(a) // decimate * decimate
+    blocks = np.asarray(a[:n], dtype=float).reshape(-1, decimate).mean(axis=1)
+    x = np.lib.stride_tricks.sliding_window_view(blocks, taps)
+    ends = (np.arange(len(x)) + taps) * decimate - 1
+    return np.column_stack([x, np.ones(len(x))]), np.asarray(z)[ends], ends
+
+
+def fit_causal_fir(pairs: list[tuple[np.ndarray, np.ndarray]], taps: int, decimate: int) -> np.ndarray:
+    """Least-squares weights (taps + 1,) of :func:`fir_rows` over the (input, target) records
+    ``pairs`` (numpy normal equations, accumulated record by record)."""
+    normal, moment = 0.0, 0.0
+    for a, z in pairs:
+        x, target, _ = fir_rows(a, z, taps, decimate)
+        normal, moment = normal + x.T @ x, moment + x.T @ target
+    return np.linalg.solve(normal, moment)
 
 
 def plot(result: dict, path: str | Path) -> None:
