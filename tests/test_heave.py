@@ -207,6 +207,11 @@ def test_band_elements_integrate_the_heave_spectrum_over_their_bands():
     acc[(omega < 0.35) | (omega > 1.15)] = 0.0         # all energy inside the band
     _, var = band_elements(Spectrum(omega, acc, acc, acc, acc), grid, 0.0)
     assert var.sum() == pytest.approx(np.sum(acc / omega ** 4) * d, rel=1e-12)
+    w, var = band_elements(Spectrum(omega, acc, acc, acc, acc), grid, 0.0, "point")   # the earlier reading
+    s_z = np.interp(grid, omega, acc) / grid ** 4
+    inside = s_z > 0                                   # the end elements at 0.3 and 1.2 rad/s read zero
+    np.testing.assert_allclose(w, grid[inside], rtol=1e-12)
+    np.testing.assert_allclose(var, (s_z * np.gradient(grid))[inside], rtol=1e-12)
 
 
 def test_spectrum_window_grows_with_the_data_up_to_window_max():
@@ -416,6 +421,7 @@ def test_bad_samples_coast_and_are_reported():
 @pytest.mark.parametrize("field,value,message", [
     ("window", 20.0, "window = 20.0 is out of range"),
     ("window_max", 100.0, "window_max = 100.0 is out of range"),
+    ("band_variance", "mean", "band_variance = 'mean' is not allowed"),
     ("max_modes", 0, "max_modes = 0 is out of range"),
     ("acc_noise", 0.0, "acc_noise = 0.0 is out of range"),
     ("mode_noise", -1.0, "mode_noise = -1.0 is out of range"),

@@ -7,6 +7,7 @@ from typing import Any
 from ..estimators.attitude import INIT_CHOICES, AttitudeParams
 from ..estimators.centre_of_rotation import ANGLE_CHOICES as CR_ANGLE_CHOICES
 from ..estimators.centre_of_rotation import CentreOfRotationParams
+from ..estimators.band_bank import BAND_VARIANCES
 from ..estimators.heave import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
 from ..estimators.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
 from ..estimators.gnss_fusion import ANTENNAS, COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
@@ -216,6 +217,7 @@ HEAVE_PARAMETERS: list[Variable] = [
     real("band_min", _HV.band_min, "rad/s", "Lowest band element (model = band; lower it for swell longer than about 16 s), (0, omega_max)"),
     real("damping", _HV.damping, "", "Damping ratio of the band elements' stages, (0, 1]"),
     Variable("stages", "integer", _HV.stages, "", "Cascaded oscillators per band element, 1..4"),
+    Variable("band_variance", "string", _HV.band_variance, "", f"Band element variance from the spectrum: one of {', '.join(BAND_VARIANCES)} (integrated over the element's band, or read at its frequency)"),
     real("spectrum_floor", _HV.spectrum_floor, "", "Band elements below this fraction of the highest heave density are left out, [0, 1)"),
     real("omega_min", _HV.omega_min, "rad/s", "Lowest frequency searched for peaks, (0, omega_max)"),
     real("omega_max", _HV.omega_max, "rad/s", "Highest frequency searched for peaks, (omega_min, 20]"),
@@ -266,7 +268,7 @@ def heave_params(values: dict[str, Any]) -> HeaveObserverParams:
         window=v["window"], window_max=v["window_max"], peak_interval=v["peak_interval"], max_modes=v["max_modes"], omega_min=v["omega_min"],
         omega_max=v["omega_max"], min_separation=v["min_separation"], min_relative=v["min_relative"],
         model=v["model"], elements=v["elements"], band_min=v["band_min"], damping=v["damping"], stages=v["stages"],
-        spectrum_floor=v["spectrum_floor"], acc_noise=v["acc_noise"], mode_noise=v["mode_noise"], offset_noise=v["offset_noise"],
+        band_variance=v["band_variance"], spectrum_floor=v["spectrum_floor"], acc_noise=v["acc_noise"], mode_noise=v["mode_noise"], offset_noise=v["offset_noise"],
         discretisation=v["discretisation"], measurement=v["measurement"], vertical=v["vertical"],
         transfer=v["transfer"], point=(v["point.x"], v["point.y"], v["point.z"]), smoother_lag=v["smoother_lag"],
         highpass_cutoff=v["highpass_cutoff"], highpass_order=v["highpass_order"],

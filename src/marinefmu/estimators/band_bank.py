@@ -34,6 +34,9 @@ from scipy.linalg import block_diag, expm, solve_continuous_lyapunov
 from .oscillator_bank import BankModel, steady_state_filter
 from .wave_peaks import Spectrum
 
+#: Ways of reading a band element's variance from the spectrum (:func:`band_elements`).
+BAND_VARIANCES = ("integral", "point")
+
 
 def resonator(omega: float, damping: float, stages: int) -> tuple[np.ndarray, np.ndarray]:
     """Continuous model of one band element (module docstring).
@@ -85,14 +88,16 @@ def band_grid(omega_min: float, omega_max: float, count: int) -> np.ndarray:
     return np.geomspace(omega_min, omega_max, count)
 
 
-def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float) -> tuple[np.ndarray, np.ndarray]:
+def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float,
+                  variance: str = "integral") -> tuple[np.ndarray, np.ndarray]:
     """Elements of the band and their heave variances from an acceleration spectrum.
 
     Element j covers the band between the geometric midpoints of its neighbours in ``grid``
-    (the end elements as far out as in), and its variance is the heave spectrum
-    S_z(ω) = S_ä(ω)/ω⁴ integrated over that band, each periodogram bin spread evenly over its
-    width. (Until 2026-11-23 it was S_z at ω_j times the element's width: one or two bins of a
-    periodogram, whose values scatter ±100 %; measured in :data:`~.heave.WINDOW_MAX`.)
+    (the end elements as far out as in). ``variance="integral"`` (default): its variance is the
+    heave spectrum S_z(ω) = S_ä(ω)/ω⁴ integrated over that band, each periodogram bin spread
+    evenly over its width. ``"point"`` (the only way until 2026-11-23): S_z interpolated at ω_j
+    times the grid's spacing there, one or two bins of a periodogram whose values scatter
+    ±100 % (measured in :data:`~.heave.WINDOW_MAX`).
 
     Parameters
     ----------
@@ -101,14 +106,20 @@ def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float) -> tuple[n
     grid : numpy.ndarray
         (M,) candidate frequencies [rad/s], ascending, geometric, M ≥ 2 (:func:`band_grid`).
     floor : float
-        Elements whose mean heave density over their band is below ``floor`` times the highest
-        are left out.
+        Elements whose mean heave density over their band (``"point"``: at ω_j) is below
+        ``floor`` times the highest are left out.
+    variance : str
+        ``"integral"`` or ``"point"`` (above).
 
     Returns
     -------
     tuple of numpy.ndarray
         Frequencies [rad/s] and heave variances [m²] of the elements kept (possibly none).
     """
+    if variance == "point":
+        s_z = np.interp(grid, spectrum.omega, spectrum.acc_density) / grid**4
+        keep = (s_z > 0.0) & (s_z >= floor * s_z.max())
+        return grid[keep], (s_z * np.gradient(grid))[keep]
     mid = np.sqrt(grid[1:] * grid[:-1])
     lo = np.concatenate([[grid[0] ** 2 / mid[0]], mid])
     hi = np.concatenate([mid, [grid[-1] ** 2 / mid[-1]]])

@@ -59,7 +59,7 @@ import numpy as np
 from ..errors import ParameterError, check_choice, check_int, check_range, check_vector
 from ..frames import G
 from .fixed_lag import FixedLagOutputs
-from .band_bank import band_elements, band_grid, build_band_bank
+from .band_bank import BAND_VARIANCES, band_elements, band_grid, build_band_bank
 from .oscillator_bank import DISCRETISATIONS, MEASUREMENTS, BankModel, build_bank, carry_map
 from .samples import angles_beyond_limit, force_beyond_limit
 from .wave_peaks import acceleration_spectrum, find_modes
@@ -154,6 +154,10 @@ class HeaveObserverParams:
     stages : int
         Cascaded oscillators per band element, 1..4 (heave spectrum ∝ ω^{2(stages−1)} below
         an element). [``stages``]
+    band_variance : str
+        ``"integral"`` (default: the heave spectrum integrated over each element's band) or
+        ``"point"`` (read at the element's frequency, as until 2026-11-23),
+        :func:`~.band_bank.band_elements`. [``band_variance``]
     spectrum_floor : float
         Band elements whose heave density is below this fraction of the highest are left out,
         [0, 1). [``spectrum_floor``]
@@ -198,6 +202,7 @@ class HeaveObserverParams:
     band_min: float = BAND_MIN
     damping: float = 0.1
     stages: int = 3
+    band_variance: str = "integral"
     spectrum_floor: float = 1e-3
     acc_noise: float = 7e-4
     mode_noise: float = 1e-2
@@ -224,6 +229,7 @@ class HeaveObserverParams:
         check_range("band_min", self.band_min, lo=0.0, hi=self.omega_max, lo_open=True, hi_open=True, unit="rad/s")
         check_range("damping", self.damping, lo=0.0, hi=1.0, lo_open=True)
         check_int("stages", self.stages, lo=1, hi=4)
+        check_choice("band_variance", self.band_variance, BAND_VARIANCES)
         check_range("spectrum_floor", self.spectrum_floor, lo=0.0, hi=1.0, hi_open=True)
         check_range("min_separation", self.min_separation, lo=0.0, hi=2.0, lo_open=True, unit="rad/s")
         check_range("min_relative", self.min_relative, lo=0.0, hi=1.0, hi_open=True)
@@ -551,7 +557,8 @@ class HeaveObserver:
         modes = find_modes(spectrum, p.omega_min, p.omega_max, p.max_modes, p.min_separation, p.min_relative)
         if p.model == "band":
             omega, variance = band_elements(spectrum, band_grid(max(p.omega_min, p.band_min), p.omega_max,
-                                                                p.elements), p.spectrum_floor)
+                                                                p.elements), p.spectrum_floor,
+                                              p.band_variance)
         else:
             omega, variance = modes.omega, None
         if len(modes) == 0 or len(omega) == 0:
