@@ -126,10 +126,10 @@ def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float,
     d_omega = spectrum.omega[1] - spectrum.omega[0]
     edges = np.concatenate([spectrum.omega - 0.5 * d_omega, [spectrum.omega[-1] + 0.5 * d_omega]])
     cumulative = np.concatenate([[0.0], np.cumsum(spectrum.acc_density / spectrum.omega**4) * d_omega])
-    variance = np.interp(hi, edges, cumulative) - np.interp(lo, edges, cumulative)
-    density = variance / (hi - lo)
+    var = np.interp(hi, edges, cumulative) - np.interp(lo, edges, cumulative)
+    density = var / (hi - lo)
     keep = (density > 0.0) & (density >= floor * density.max())
-    return grid[keep], variance[keep]
+    return grid[keep], var[keep]
 
 
 def build_band_bank(omega: np.ndarray, variance: np.ndarray, dt: float, damping: float, stages: int,

@@ -54,6 +54,13 @@ def _rms(e: np.ndarray) -> float:
     return float(np.sqrt(np.mean(e ** 2)))
 
 
+def imu_error(rec: dict[str, np.ndarray], heave: np.ndarray) -> np.ndarray:
+    """Real-time heave error at the IMU [m] from :data:`SETTLE` on, against the truth less its
+    mean over that part (the checks' scoring)."""
+    k0 = int(SETTLE / DT)
+    return heave[k0:] - (rec["truth.imu.d"][k0:] - rec["truth.imu.d"][k0:].mean())
+
+
 def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
     """RMS errors [m] of the band model, the paper's modes and the high-pass baseline."""
     rec = record(hs, tp, duration)
@@ -70,8 +77,7 @@ def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
                        "rms_imu": _rms(out[k0:, 0] - truth["imu"][k0:]),
                        "rms_point": _rms(out[k0:, 1] - truth["point"][k0:]),
                        "rms_delayed": _rms(out[k0 + lag:, 2] - truth["imu"][k0:len(out) - lag]), "delay": obs.delay}
-    f, roll, pitch = stack(rec, "imu.acc"), rec["truth.roll"], rec["truth.pitch"]
-    a_imu = np.array([vertical_acceleration(f[k], roll[k], pitch[k], "ned") for k in range(len(f))])
+    a_imu = vertical_record(rec)
     a_pt = rec["truth.point_acc.d"]  # at the point the baseline gets the exact acceleration: its best case
     hp = {}
     for where, acc in (("imu", a_imu), ("point", a_pt)):
@@ -99,9 +105,7 @@ def band_min_study(values: tuple[float, ...] = (0.25, 0.3, 0.35), duration: floa
     from ..peer_orcaflex import heave_scores, load_orcaflex
 
     def errors(rec: dict, band_min: float) -> dict[str, float]:
-        out, _ = run_observer(HeaveObserverParams(point=ARM, band_min=band_min), rec)
-        k0 = int(SETTLE / DT)
-        e = out[k0:, 0] - (rec["truth.imu.d"][k0:] - rec["truth.imu.d"][k0:].mean())
+        e = imu_error(rec, run_observer(HeaveObserverParams(point=ARM, band_min=band_min), rec)[0][:, 0])
         f, psd = signal.welch(e, fs=1.0 / DT, nperseg=8192)
         low = 2.0 * math.pi * f < 0.2
         return {"rms_cm": 100.0 * _rms(e), "below_0.2_rad_s_cm": 100.0 * math.sqrt(float(np.sum(psd[low])) * f[1])}
@@ -121,13 +125,11 @@ def window_max_study(values: tuple[float, ...] = (120.0, 600.0), duration: float
     checks (Hs 4 m, Tp 12 and 14 s) and on smsfusion's OrcaFlex record (6 minutes, true angles)."""
     from ..peer_orcaflex import heave_scores, load_orcaflex
 
-    k0 = int(SETTLE / DT)
     result: dict = {}
     for hs, tp in ((4.0, 12.0), (4.0, 14.0)):
         rec = record(hs, tp, duration)
-        truth = rec["truth.imu.d"][k0:] - rec["truth.imu.d"][k0:].mean()
         result[f"Hs {hs:g} Tp {tp:g}"] = {
-            f"{w:g}": 100.0 * _rms(run_observer(HeaveObserverParams(point=ARM, window_max=w), rec)[0][k0:, 0] - truth)
+            f"{w:g}": 100.0 * _rms(imu_error(rec, run_observer(HeaveObserverParams(point=ARM, window_max=w), rec)[0][:, 0]))
             for w in values}
     orca = load_orcaflex()
     result["OrcaFlex, true angles"] = {
