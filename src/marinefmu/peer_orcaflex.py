@@ -158,9 +158,10 @@ def heave_run(rec: OrcaflexRecord, roll: np.ndarray, pitch: np.ndarray,
               **params: Any) -> tuple[np.ndarray, np.ndarray]:
     """Heave [m, down] and ``valid`` of marinefmu's HeaveObserver fed by ``roll``/``pitch``
     (``params``: more :class:`~.estimators.heave.HeaveObserverParams` fields)."""
-    from .estimators.heave import HeaveObserver, HeaveObserverParams
+    from .estimators.heave import HeaveObserverParams
+    from .estimators.highpass_heave import heave_estimator
 
-    obs = HeaveObserver(HeaveObserverParams(acc_noise=sensor_noise(rec)[0], **params), quiet=True)
+    obs = heave_estimator(HeaveObserverParams(acc_noise=sensor_noise(rec)[0], **params), quiet=True)
     heave = np.empty(len(rec.acc))
     valid = np.empty(len(rec.acc), dtype=bool)
     for k in range(len(rec.acc)):

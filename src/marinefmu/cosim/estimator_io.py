@@ -211,7 +211,7 @@ HEAVE_PARAMETERS: list[Variable] = [
     real("window", _HV.window, "s", "First spectrum window (valid after it), >= two periods of omega_min (4 pi/omega_min), <= 3600"),
     real("window_max", _HV.window_max, "s", "Longest spectrum window: it grows with the data from window to this (= window: the paper's fixed window), [window, 3600]"),
     real("peak_interval", _HV.peak_interval, "s", "Time between peak detections (paper 003: T = 15 s), (0, 3600]"),
-    Variable("model", "string", _HV.model, "", f"Observer model: one of {', '.join(MODEL_CHOICES)} (spectrum-weighted comb of band-pass elements, the paper's undamped modes at the peaks, or the classical high-pass double integration as a baseline)"),
+    Variable("model", "string", _HV.model, "", f"Observer model: one of {', '.join(MODEL_CHOICES)} (spectrum-weighted comb of band-pass elements, the paper's undamped modes at the peaks, the classical high-pass double integration as a baseline, or the causal Wiener filter designed from the spectrum)"),
     Variable("max_modes", "integer", _HV.max_modes, "", "Most oscillator modes (model = peaks), 1..20"),
     Variable("elements", "integer", _HV.elements, "", "Grid size of the band model, 2..100"),
     real("band_min", _HV.band_min, "rad/s", "Lowest band element (model = band; lower it for swell longer than about 16 s), (0, omega_max)"),

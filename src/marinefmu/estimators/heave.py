@@ -74,7 +74,7 @@ class _Silent:
         """Drop the message."""
 
 VERTICAL_CHOICES = ("ned", "tilt", "paper")
-MODEL_CHOICES = ("band", "peaks", "highpass")
+MODEL_CHOICES = ("band", "peaks", "highpass", "wiener")
 TRANSFER_CHOICES = ("exact", "paper")
 #: Default lowest band element ``band_min`` [rad/s] (:class:`HeaveObserverParams`). Measured
 #: 2026-11-23, real-time heave RMS error at the IMU [cm], default MEMS noise, truth angles;
@@ -129,7 +129,9 @@ class HeaveObserverParams:
     model : str
         ``"band"`` (default) or ``"peaks"`` (the paper's modes), module docstring; or
         ``"highpass"``, the classical high-pass double integration
-        (:class:`~.highpass_heave.HighpassHeave`, a baseline, not this class). [``model``]
+        (:class:`~.highpass_heave.HighpassHeave`, a baseline, not this class); or
+        ``"wiener"``, the causal Wiener filter designed from the spectrum
+        (:class:`~.wiener_heave.WienerHeave`, not this class). [``model``]
     max_modes : int
         Most oscillator modes, 1..20 (``model="peaks"``). [``max_modes``]
     omega_min, omega_max : float
@@ -415,9 +417,9 @@ class HeaveObserver:
 
     def __init__(self, params: HeaveObserverParams | None = None, *, quiet: bool = False) -> None:
         self.params = params or HeaveObserverParams()
-        if self.params.model == "highpass":
-            raise ParameterError("model = 'highpass' is the classical baseline, not an observer model: use "
-                                 "estimators.highpass_heave.HighpassHeave or heave_estimator(params)")
+        if self.params.model in ("highpass", "wiener"):
+            raise ParameterError(f"model = {self.params.model!r} is not an observer model: use "
+                                 "estimators.highpass_heave.heave_estimator(params)")
         self.log: Any = _Silent() if quiet else log
         self.reset()
 

@@ -30,6 +30,7 @@ from scipy import signal
 from .heave import HeaveObserver, HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, read_sample, \
     vertical_acceleration
 from .integration import highpass_sections
+from .wiener_heave import WienerHeave
 
 log = logging.getLogger(__name__)
 
@@ -140,9 +141,13 @@ def _run(sos: list[tuple[float, ...]], state: list[list[float]], x: float) -> fl
     return x
 
 
-def heave_estimator(params: HeaveObserverParams, *, quiet: bool = False) -> HeaveObserver | HighpassHeave:
-    """The estimator ``params.model`` names: :class:`HighpassHeave` for ``"highpass"``, else
-    :class:`.HeaveObserver` (what the HeaveObserver FMU runs)."""
+def heave_estimator(params: HeaveObserverParams, *,
+                    quiet: bool = False) -> HeaveObserver | HighpassHeave | WienerHeave:
+    """The estimator ``params.model`` names: :class:`HighpassHeave` for ``"highpass"``,
+    :class:`.WienerHeave` for ``"wiener"``, else :class:`.HeaveObserver` (what the
+    HeaveObserver FMU runs)."""
     if params.model == "highpass":
         return HighpassHeave(params, quiet=quiet)
+    if params.model == "wiener":
+        return WienerHeave(params, quiet=quiet)
     return HeaveObserver(params, quiet=quiet)
