@@ -8,6 +8,7 @@ from conftest import DT, Driver
 
 from marinefmu.cosim.estimator_io import heave_params
 from marinefmu.estimators.heave import HeaveObserver
+from marinefmu.estimators.wiener_heave import WienerHeave
 
 OUTS = ["heave", "heave_rate", "point.heave", "point.heave_rate", "delayed.heave", "delayed.point.heave",
         "delayed.delay", "offset", "peak_period"]
@@ -54,4 +55,27 @@ def test_heave_fmu_state_restore_repeats_the_run(fmu_dir, tmp_path):
     again = [f.step(k, _inputs(k), OUTS)[1] for k in range(4200, 4300)]
     assert again == first
     f.fmu.freeFMUstate(state)
+    f.close()
+
+
+@pytest.mark.fmu
+def test_wiener_heave_fmu_equals_in_process(fmu_dir, tmp_path):
+    """model = "wiener" (the Wiener filter from the spectrum) through the FMU, with a NaN sample."""
+    params = {**PARAMS, "model": "wiener"}
+    f = Driver(fmu_dir / "HeaveObserver.fmu", tmp_path, "heave_wiener")
+    f.init(params)
+    est = WienerHeave(heave_params(params))
+    for k in range(5000):
+        inputs = _inputs(k)
+        if k == 4500:
+            inputs["acc.z"] = math.nan
+        status, reals, flags = f.step(k, inputs, OUTS, ("valid", "delayed.valid"))
+        r = est.step((inputs["acc.x"], inputs["acc.y"], inputs["acc.z"]), inputs["roll"], inputs["pitch"], DT)
+        assert status in (0, None)
+        assert reals == [r.heave, r.heave_rate, r.point_heave, r.point_heave_rate, r.delayed_heave,
+                         r.delayed_point_heave, r.delay, r.offset, r.peak_period], k
+        assert flags == [r.valid, r.delayed_valid]
+        if k == 4500:
+            assert not flags[0] and all(np.isfinite(reals))
+    assert all(flags) and reals[0] != 0.0
     f.close()

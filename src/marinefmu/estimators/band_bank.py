@@ -32,7 +32,7 @@ import numpy as np
 from scipy.linalg import block_diag, expm, solve_continuous_lyapunov
 
 from .oscillator_bank import BankModel, steady_state_filter
-from .wave_peaks import Spectrum
+from .wave_peaks import Spectrum, band_integral
 
 #: Ways of reading a band element's variance from the spectrum (:func:`band_elements`).
 BAND_VARIANCES = ("integral", "point")
@@ -123,10 +123,7 @@ def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float,
     mid = np.sqrt(grid[1:] * grid[:-1])
     lo = np.concatenate([[grid[0] ** 2 / mid[0]], mid])
     hi = np.concatenate([mid, [grid[-1] ** 2 / mid[-1]]])
-    d_omega = spectrum.omega[1] - spectrum.omega[0]
-    edges = np.concatenate([spectrum.omega - 0.5 * d_omega, [spectrum.omega[-1] + 0.5 * d_omega]])
-    cumulative = np.concatenate([[0.0], np.cumsum(spectrum.acc_density / spectrum.omega**4) * d_omega])
-    var = np.interp(hi, edges, cumulative) - np.interp(lo, edges, cumulative)
+    var = band_integral(spectrum.omega, spectrum.acc_density / spectrum.omega**4, lo, hi)
     density = var / (hi - lo)
     keep = (density > 0.0) & (density >= floor * density.max())
     return grid[keep], var[keep]

@@ -83,6 +83,25 @@ def acceleration_spectrum(acc: np.ndarray, dt: float) -> Spectrum:
     return Spectrum(omega, amp, amp / omega**2, np.angle(np.exp(1j * (phase - math.pi))), density)
 
 
+def band_integral(omega: np.ndarray, density: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Integral of a density given at uniform bins ``omega`` over the bands [lo, hi], each bin's
+    value spread evenly over its width (beyond the outer bins: nothing).
+
+    Parameters
+    ----------
+    omega : numpy.ndarray
+        (K,) uniform bin centres [rad/s].
+    density : numpy.ndarray
+        (K,) density per rad/s at them.
+    lo, hi : numpy.ndarray
+        Band edges [rad/s], lo ≤ hi, any shape.
+    """
+    d_omega = omega[1] - omega[0]
+    edges = np.concatenate([omega - 0.5 * d_omega, [omega[-1] + 0.5 * d_omega]])
+    cumulative = np.concatenate([[0.0], np.cumsum(density) * d_omega])
+    return np.interp(hi, edges, cumulative) - np.interp(lo, edges, cumulative)
+
+
 @dataclass(frozen=True)
 class Modes:
     """Modes from the peak detection, ascending in frequency.
