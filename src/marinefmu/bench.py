@@ -200,7 +200,8 @@ def heave_accuracy() -> dict[str, dict]:
                                           "goal_cm": goal, "met": met, "causal_bound_cm": bound["bound_cm"]}
         print(f"heave Hs {hs:g} m Tp {tp:g} s: band {band['rms_imu']:.2f} / {band['rms_point']:.2f} cm, delayed "
               f"{band['rms_delayed']:.2f} cm (goal {goal['real_time_imu']:.2f} / {goal['real_time_point']:.2f} / "
-              f"{goal['delayed']:.2f} cm: {'met' if met else 'NOT met'}); paper's modes {runs['peaks (paper)']['rms_imu']:.2f} cm; "
+              f"{goal['delayed']:.2f} cm: {'met' if met else 'NOT met'}); wiener {runs['wiener']['rms_imu']:.2f} / "
+              f"{runs['wiener']['rms_point']:.2f} / {runs['wiener']['rms_delayed']:.2f} cm; paper's modes {runs['peaks (paper)']['rms_imu']:.2f} cm; "
               f"high-pass {runs['high-pass']['rms_imu']:.2f} cm; causal bound at the IMU {bound['bound_cm']:.2f} cm",
               flush=True)
     return result

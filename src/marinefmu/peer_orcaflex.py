@@ -245,6 +245,7 @@ def compare_orcaflex(rec: OrcaflexRecord | None = None) -> dict[str, dict[str, f
         out[name] = {"roll_deg": float(e[0]), "pitch_deg": float(e[1])}
     roll, pitch = att["marinefmu AttitudeEstimator"].T
     out["marinefmu HeaveObserver"] = heave_scores(rec, roll, pitch)
+    out["marinefmu HeaveObserver (wiener)"] = heave_scores(rec, roll, pitch, model="wiener")
     f_n = rotate_to_ned(rec.acc, roll, pitch, rec.heading)
     fix = np.arange(len(rec.acc)) % FIX_EVERY == 0
     fix[:k0] = False

@@ -6,11 +6,12 @@ specific force and the true roll and pitch; errors are RMS after 2 minutes of se
 positive down, against the truth at the IMU and at the bow point.
 
 * :func:`compare`: the default band model (real time and delayed), the paper's undamped modes
-  (``model = peaks`` with the paper's fixed 120 s spectrum window), and the high-pass double integration of most motion reference units
+  (``model = peaks`` with the paper's fixed 120 s spectrum window), the causal Wiener filter from
+  the spectrum (``model = wiener``, beyond the paper), and the high-pass double integration of most motion reference units
   (4th-order Butterworth, causal) at the cutoff best for the record among
   :data:`HP_CUTOFFS` (chosen at each place), fed the vertical acceleration at the IMU (the same sensor) and, at the
   bow point, the point's exact acceleration (a noise-free sensor there: its best case).
-* :func:`plot`: a minute of bow heave (truth and the three real-time estimates) and the error
+* :func:`plot`: a minute of bow heave (truth and the four real-time estimates) and the error
   of each over the whole run.
 """
 from __future__ import annotations
@@ -21,7 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from ..estimators.heave import HeaveObserver, HeaveObserverParams, vertical_acceleration
+from ..estimators.highpass_heave import heave_estimator
 from ..estimators.integration import highpass_double_integration
+from ..estimators.wiener_heave import WienerHeave
 from ..sea.motion_model import VesselMotionParams, simulate_record, stack
 
 DT = 0.05
@@ -41,9 +44,11 @@ def record(hs: float, tp: float, duration: float = 1920.0, seed: int = 3,
     return simulate_record(VesselMotionParams.from_flat(flat), duration, DT)
 
 
-def run_observer(params: HeaveObserverParams, rec: dict[str, np.ndarray]) -> tuple[np.ndarray, HeaveObserver]:
-    """(N, 3) real-time heave at the IMU, at the point, and delayed heave at the IMU [m, down]."""
-    obs = HeaveObserver(params)
+def run_observer(params: HeaveObserverParams,
+                 rec: dict[str, np.ndarray]) -> tuple[np.ndarray, HeaveObserver | WienerHeave]:
+    """(N, 3) real-time heave at the IMU, at the point, and delayed heave at the IMU [m, down]
+    (``params.model`` an observer's or ``"wiener"``)."""
+    obs = heave_estimator(params)
     acc, roll, pitch = stack(rec, "imu.acc"), rec["truth.roll"], rec["truth.pitch"]
     out = np.array([[r.heave, r.point_heave, r.delayed_heave]
                     for r in (obs.step(acc[k], roll[k], pitch[k], DT) for k in range(len(acc)))])
@@ -62,7 +67,8 @@ def imu_error(rec: dict[str, np.ndarray], heave: np.ndarray) -> np.ndarray:
 
 
 def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
-    """RMS errors [m] of the band model, the paper's modes and the high-pass baseline."""
+    """RMS errors [m] of the band model, the paper's modes, the Wiener filter (``model="wiener"``)
+    and the high-pass baseline."""
     rec = record(hs, tp, duration)
     k0 = int(SETTLE / DT)
     truth = {"imu": rec["truth.imu.d"] - rec["truth.imu.d"][k0:].mean(),
@@ -70,7 +76,8 @@ def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
     runs = {}
     for label, params in (("band", HeaveObserverParams(point=ARM)),
                           ("peaks (paper)", HeaveObserverParams(point=ARM, model="peaks", offset_noise=3e-4,
-                                                                window_max=120.0))):   # the paper's fixed window
+                                                                window_max=120.0)),    # the paper's fixed window
+                          ("wiener", HeaveObserverParams(point=ARM, model="wiener"))):
         out, obs = run_observer(params, rec)
         lag = int(round(obs.delay / DT))
         runs[label] = {"imu": out[:, 0], "point": out[:, 1],
@@ -233,7 +240,7 @@ def plot(result: dict, path: str | Path) -> None:
     window = (t >= t[-1] - 60.0)
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 6.5))
     top.plot(t[window], -truth[window], "k", lw=2, label="truth")
-    colours = {"band": "tab:blue", "peaks (paper)": "tab:orange", "high-pass": "tab:green"}
+    colours = {"band": "tab:blue", "peaks (paper)": "tab:orange", "high-pass": "tab:green", "wiener": "tab:red"}
     for label, r in runs.items():
         name = f"{label} ({100 * r['rms_point']:.1f} cm RMS)"
         top.plot(t[window], -r["point"][window], color=colours[label], lw=1, label=name)
