@@ -80,6 +80,7 @@ def _heave(out: Path) -> dict:
     figures = {f"{label} RMS error IMU/point [cm]": 100 * np.array([run["rms_imu"], run["rms_point"]])
                for label, run in r["runs"].items()}
     figures["band delayed heave RMS error [cm]"] = 100 * r["runs"]["band"]["rms_delayed"]
+    figures["wiener delayed heave RMS error [cm]"] = 100 * r["runs"]["wiener"]["rms_delayed"]
     figures["heave std IMU/point [cm]"] = 100 * np.array([r["std_imu"], r["std_point"]])
     return figures
 
