@@ -21,23 +21,30 @@ def _inputs(k):
             "roll": 0.02 * math.sin(0.7 * t), "pitch": 0.03 * math.cos(0.8 * t)}
 
 
+def _run_beside(f, est, steps, nan_at):
+    """Step the FMU and the in-process estimator alike (a NaN acc.z at ``nan_at``): equal outputs
+    and flags at every step, valid false and finite outputs at the NaN; the last outputs, flags."""
+    for k in range(steps):
+        inputs = _inputs(k)
+        if k == nan_at:
+            inputs["acc.z"] = math.nan
+        status, reals, flags = f.step(k, inputs, OUTS, ("valid", "delayed.valid"))
+        r = est.step((inputs["acc.x"], inputs["acc.y"], inputs["acc.z"]), inputs["roll"], inputs["pitch"], DT)
+        assert status in (0, None)
+        assert reals == [r.heave, r.heave_rate, r.point_heave, r.point_heave_rate, r.delayed_heave,
+                         r.delayed_point_heave, r.delay, r.offset, r.peak_period], k
+        assert flags == [r.valid, r.delayed_valid]
+        if k == nan_at:
+            assert not flags[0] and all(np.isfinite(reals))
+    return reals, flags
+
+
 @pytest.mark.fmu
 def test_heave_fmu_equals_in_process(fmu_dir, tmp_path):
     f = Driver(fmu_dir / "HeaveObserver.fmu", tmp_path, "heave")
     f.init(PARAMS)
     obs = HeaveObserver(heave_params(PARAMS))
-    for k in range(5500):
-        inputs = _inputs(k)
-        if k == 5000:
-            inputs["acc.z"] = math.nan
-        status, reals, flags = f.step(k, inputs, OUTS, ("valid", "delayed.valid"))
-        r = obs.step((inputs["acc.x"], inputs["acc.y"], inputs["acc.z"]), inputs["roll"], inputs["pitch"], DT)
-        assert status in (0, None)
-        assert reals == [r.heave, r.heave_rate, r.point_heave, r.point_heave_rate, r.delayed_heave,
-                         r.delayed_point_heave, r.delay, r.offset, r.peak_period], k
-        assert flags == [r.valid, r.delayed_valid]
-        if k == 5000:
-            assert not flags[0] and all(np.isfinite(reals))
+    flags = _run_beside(f, obs, 5500, 5000)[1]
     assert f.fmu.getInteger([f.vr["modes"].valueReference]) == [obs._result.modes] and obs._result.modes >= 2
     assert all(flags)
     f.close()
@@ -65,17 +72,6 @@ def test_wiener_heave_fmu_equals_in_process(fmu_dir, tmp_path):
     f = Driver(fmu_dir / "HeaveObserver.fmu", tmp_path, "heave_wiener")
     f.init(params)
     est = WienerHeave(heave_params(params))
-    for k in range(5000):
-        inputs = _inputs(k)
-        if k == 4500:
-            inputs["acc.z"] = math.nan
-        status, reals, flags = f.step(k, inputs, OUTS, ("valid", "delayed.valid"))
-        r = est.step((inputs["acc.x"], inputs["acc.y"], inputs["acc.z"]), inputs["roll"], inputs["pitch"], DT)
-        assert status in (0, None)
-        assert reals == [r.heave, r.heave_rate, r.point_heave, r.point_heave_rate, r.delayed_heave,
-                         r.delayed_point_heave, r.delay, r.offset, r.peak_period], k
-        assert flags == [r.valid, r.delayed_valid]
-        if k == 4500:
-            assert not flags[0] and all(np.isfinite(reals))
+    reals, flags = _run_beside(f, est, 5000, 4500)
     assert all(flags) and reals[0] != 0.0
     f.close()

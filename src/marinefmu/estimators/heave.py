@@ -340,6 +340,21 @@ def read_sample(acc: Any, roll: float, pitch: float) -> tuple[np.ndarray, float,
     return f, roll, pitch, _bad_sample(f, roll, pitch)
 
 
+def read_and_start(estimator: Any, acc: Any, roll: float, pitch: float,
+                   dt: float) -> tuple[np.ndarray, float, float, str | None]:
+    """:func:`read_sample`, and the start of a sample-by-sample heave filter (its ``dt``,
+    ``reset()`` and ``_start(dt)``, as :class:`~.highpass_heave.HighpassHeave` and
+    :class:`~.wiener_heave.WienerHeave` have them): at the first step, or afresh when the step
+    size changes (that reason then replaces the sample's)."""
+    f, roll, pitch, warning = read_sample(acc, roll, pitch)
+    if estimator.dt is not None and abs(dt - estimator.dt) > 1e-9 * estimator.dt:
+        warning = f"step size changed from {estimator.dt} s to {dt} s; filter restarted"
+        estimator.reset()
+    if estimator.dt is None:
+        estimator._start(dt)
+    return f, roll, pitch, warning
+
+
 def _bad_sample(acc: np.ndarray, roll: float, pitch: float) -> str | None:
     if not (np.all(np.isfinite(acc)) and math.isfinite(roll) and math.isfinite(pitch)):
         return "non-finite acceleration or angle sample"

@@ -27,8 +27,8 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .heave import HeaveObserver, HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, read_sample, \
-    vertical_acceleration
+from .heave import HeaveObserver, HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, \
+    read_and_start, vertical_acceleration
 from .integration import highpass_sections
 from .wiener_heave import WienerHeave
 
@@ -93,12 +93,7 @@ class HighpassHeave:
     def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
         """Process one sample (arguments as :meth:`.HeaveObserver.step`)."""
         p = self.params
-        f, roll, pitch, warning = read_sample(acc, roll, pitch)
-        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
-            warning = f"step size changed from {self.dt} s to {dt} s; filter restarted"
-            self.reset()
-        if self.dt is None:
-            self._start(dt)
+        f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
         if warning is None:
             a_v = vertical_acceleration(f, roll, pitch, p.vertical)
             self.last = (a_v, roll, pitch)

@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 from scipy.linalg import solve_toeplitz
 
-from .heave import HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, read_sample, \
+from .heave import HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, read_and_start, \
     vertical_acceleration
 from .wave_peaks import Spectrum, acceleration_spectrum, band_integral
 
@@ -230,12 +230,7 @@ class WienerHeave:
     def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
         """Process one sample (arguments as :meth:`.HeaveObserver.step`)."""
         p = self.params
-        f, roll, pitch, warning = read_sample(acc, roll, pitch)
-        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
-            warning = f"step size changed from {self.dt} s to {dt} s; filter restarted"
-            self.reset()
-        if self.dt is None:
-            self._start(dt)
+        f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
         if warning is None:
             a_v = vertical_acceleration(f, roll, pitch, p.vertical)
             self.last_angles = (roll, pitch)
