@@ -184,8 +184,6 @@ class WienerHeave:
         self.tap_sums = np.zeros(4)
         self.mean = 0.0
         self.peak_period = 0.0
-        self.angles: list[tuple[float, float]] = []
-        self.last_angles = (0.0, 0.0)
 
     def _start(self, dt: float) -> None:
         p = self.params
@@ -208,6 +206,12 @@ class WienerHeave:
         """The buffered accelerations (at most ``window_max`` s), oldest first."""
         n = len(self.spectrum_buf)
         return np.roll(self.spectrum_buf, -(self.k % n))[-min(self.k, n):]
+
+    def _angles(self, age: int, count: int) -> list[tuple[float, float]]:
+        """``count`` (roll, pitch) samples [rad], oldest first, ending ``age`` samples before the
+        newest stored one."""
+        n = len(self.angle_buf)
+        return [tuple(self.angle_buf[(self.k - 1 - age - j) % n]) for j in range(count - 1, -1, -1)]
 
     def _design(self) -> None:
         """Steps 1-2 on the window: new taps and mean."""
@@ -233,12 +237,10 @@ class WienerHeave:
         f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
         if warning is None:
             a_v = vertical_acceleration(f, roll, pitch, p.vertical)
-            self.last_angles = (roll, pitch)
         else:
             self.log.warning("wiener heave: %s; the window's mean acceleration used", warning)
             a_v = self.mean
-            roll, pitch = self.last_angles
-        self.angles = (self.angles + [(roll, pitch)])[-3:]
+            roll, pitch = self._angles(0, 1)[0] if self.k else (0.0, 0.0)      # the last good ones
         self.spectrum_buf[self.k % len(self.spectrum_buf)] = a_v
         i = self.k % self.n_fir
         self.fir_buf[i] = self.fir_buf[i + self.n_fir] = a_v
@@ -252,8 +254,9 @@ class WienerHeave:
         n = self.taps.shape[1]
         recent = self.fir_buf[i + 1 + self.n_fir - n:i + 1 + self.n_fir][::-1]          # newest first
         heave, rate, d_heave, d_rate = self.taps @ recent - self.mean * self.tap_sums
-        ph, pr = point_heave(heave, rate, p.point, roll, pitch, *backward_rate(self.angles, self.dt), p.transfer)
-        old = [tuple(self.angle_buf[(self.k - 1 - self.lag_steps - j) % len(self.angle_buf)]) for j in (2, 1, 0)]
+        rates = backward_rate(self._angles(0, min(3, self.k)), self.dt)
+        ph, pr = point_heave(heave, rate, p.point, roll, pitch, *rates, p.transfer)
+        old = self._angles(self.lag_steps, 3)
         d_point, _ = point_heave(d_heave, d_rate, p.point, *old[-1], *backward_rate(old, self.dt), p.transfer)
         delayed_valid = self.k * self.dt >= p.window + self.delay
         return HeaveResult(float(heave), float(rate), ph, pr, float(d_heave), float(d_rate), d_point, self.delay,
@@ -265,8 +268,7 @@ class WienerHeave:
             return None if v is None else np.asarray(v).tolist()
         return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect, "spectrum_buf": arr(self.spectrum_buf),
                 "fir_buf": arr(self.fir_buf), "angle_buf": arr(self.angle_buf), "taps": arr(self.taps),
-                "mean": self.mean, "peak_period": self.peak_period, "angles": [list(a) for a in self.angles],
-                "last_angles": list(self.last_angles)}
+                "mean": self.mean, "peak_period": self.peak_period}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -282,5 +284,3 @@ class WienerHeave:
             self.taps = np.array(s["taps"], dtype=float)
             self.tap_sums = self.taps.sum(axis=1)
         self.mean, self.peak_period = float(s["mean"]), float(s["peak_period"])
-        self.angles = [tuple(a) for a in s["angles"]]
-        self.last_angles = tuple(s["last_angles"])
