@@ -27,8 +27,9 @@ def test_design_passes_a_strong_sea_with_unit_gain_and_no_gain_at_zero_frequency
     to zero, so a constant acceleration (a bias) gives no heave."""
     omega = 2 * math.pi * np.arange(1, 6001) / (12000 * DT)         # a 600 s window's bins
     s_z = np.exp(-0.5 * ((omega - 0.6) / 0.05) ** 2) / (0.05 * math.sqrt(2 * math.pi))
-    taps = wiener_taps(omega, s_z, DT, 8, 450, 5.0, N, Q)
-    assert taps.shape == (4, 3600)
+    weights = wiener_taps(omega, s_z, DT, 8, 450, 5.0, N, Q)
+    assert weights.shape == (4, 450)
+    taps = np.repeat(weights / 8, 8, axis=1)                          # each block mean over its samples
     np.testing.assert_allclose(taps.sum(axis=1), 0.0, atol=1e-9 * np.abs(taps).sum())
     w = np.array([0.55, 0.6, 0.65])
     h = _response(taps, w) * -(w**2)                                  # heave in, estimate out
@@ -82,6 +83,23 @@ def test_bias_step_and_bad_samples():
     # the filter's noise model keeps it from trusting the lines fully)
     heave = np.array([r.heave for r in ref])
     assert np.sqrt(np.mean((heave[1500:] - z[1500:]) ** 2)) < 1e-3
+
+
+def test_response_predicts_the_output():
+    """Between designs the filter is linear and time-invariant: on a noise-free two-line sea its
+    real-time heave is Re(H(ω) z) summed over the lines, with H from ``response`` (block sums of
+    a running sum in the filter, an independent sum of complex exponentials here), to 1e-9 m."""
+    t = np.arange(1, 3001) * 0.1
+    acc, _ = _sea(t)
+    est = WienerHeave(HeaveObserverParams(model="wiener", window=60.0, omega_min=0.3))
+    out = _run(est, acc)
+    h = est.response(np.array([0.7, 1.1]))
+    assert h.shape == (2,) and abs(h[0] - 1) < 0.01 and abs(h[1] - 1) < 0.01
+    tilt = math.cos(0.01) * math.cos(0.02)                    # _run's roll and pitch
+    since = est.next_detect - 150                             # the last design, 15 s before the next
+    lines = 0.5 * h[0] * np.exp(0.7j * t) + 0.3 * h[1] * np.exp(1j * (1.1 * t + 1.0))
+    np.testing.assert_allclose([r.heave for r in out[since:]], tilt * lines.real[since:], rtol=0, atol=1e-9)
+    assert WienerHeave().response(0.5) is None
 
 
 def test_state_restore_repeats_the_run():
