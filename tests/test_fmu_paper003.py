@@ -12,7 +12,7 @@ from marinefmu.estimators.wiener_heave import WienerHeave
 
 OUTS = ["heave", "heave_rate", "point.heave", "point.heave_rate", "delayed.heave", "delayed.point.heave",
         "delayed.delay", "offset", "peak_period"]
-PARAMS = {"window": 40.0, "omega_min": 0.35, "smoother_lag": 2.0, "point.x": 40.0, "point.z": -5.0}
+PARAMS = {"model": "band", "window": 40.0, "omega_min": 0.35, "smoother_lag": 2.0, "point.x": 40.0, "point.z": -5.0}
 
 
 def _inputs(k):

@@ -83,7 +83,7 @@ def test_a_bad_sample_is_held_flagged_and_the_state_round_trips(caplog):
 
 def test_the_model_switch_and_its_parameters():
     assert isinstance(heave_estimator(HeaveObserverParams(model="highpass")), HighpassHeave)
-    assert isinstance(heave_estimator(HeaveObserverParams()), HeaveObserver)
+    assert isinstance(heave_estimator(HeaveObserverParams(model="band")), HeaveObserver)
     with pytest.raises(ParameterError, match="model = .highpass. is not an observer model"):
         HeaveObserver(HeaveObserverParams(model="highpass"))
     with pytest.raises(ParameterError, match=r"highpass_cutoff = 6\.0 is out of range"):

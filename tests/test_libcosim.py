@@ -94,7 +94,8 @@ def test_heave_observer_fed_by_vessel_motion_in_libcosim(fmu_dir):
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
-    from marinefmu.estimators.heave import HeaveObserver, HeaveObserverParams
+    from marinefmu.estimators.heave import HeaveObserverParams
+    from marinefmu.estimators.highpass_heave import heave_estimator
     from marinefmu.sea.motion_model import REAL_INDEX
 
     log_output_level(CosimLogLevel.ERROR)
@@ -122,7 +123,7 @@ def test_heave_observer_fed_by_vessel_motion_in_libcosim(fmu_dir):
     valid = obs.last_boolean_values(h, [hvr["valid"]])[0]
 
     m = VesselMotionModel(VesselMotionParams.from_flat(vparams))
-    est = HeaveObserver(HeaveObserverParams(window=60.0, point=(40.0, 0.0, 0.0)))
+    est = heave_estimator(HeaveObserverParams(window=60.0, point=(40.0, 0.0, 0.0)))     # the default model
     y = m.peek(0.0)
     for k in range(steps):
         r = est.step([y[REAL_INDEX[f"imu.acc.{a}"]] for a in "xyz"], y[REAL_INDEX["truth.roll"]],

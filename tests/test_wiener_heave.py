@@ -114,6 +114,8 @@ def test_state_restore_repeats_the_run():
 
 def test_model_switch():
     assert isinstance(heave_estimator(HeaveObserverParams(model="wiener")), WienerHeave)
+    assert HeaveObserverParams().model == "wiener"                # the default
+    assert HeaveObserver().params.model == "band"                # the observer class's own default
     with pytest.raises(ParameterError, match="model = 'wiener' is not an observer model"):
         HeaveObserver(HeaveObserverParams(model="wiener"))
     with pytest.raises(ParameterError, match="model = 'kalman' is not allowed"):

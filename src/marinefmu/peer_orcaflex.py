@@ -244,8 +244,8 @@ def compare_orcaflex(rec: OrcaflexRecord | None = None) -> dict[str, dict[str, f
         e = np.degrees(_rms(rp[k0:] - rec.euler[k0:, :2]))
         out[name] = {"roll_deg": float(e[0]), "pitch_deg": float(e[1])}
     roll, pitch = att["marinefmu AttitudeEstimator"].T
-    out["marinefmu HeaveObserver"] = heave_scores(rec, roll, pitch)
-    out["marinefmu HeaveObserver (wiener)"] = heave_scores(rec, roll, pitch, model="wiener")
+    out["marinefmu HeaveObserver"] = heave_scores(rec, roll, pitch)                 # the default, model = "wiener"
+    out["marinefmu HeaveObserver (band)"] = heave_scores(rec, roll, pitch, model="band")
     f_n = rotate_to_ned(rec.acc, roll, pitch, rec.heading)
     fix = np.arange(len(rec.acc)) % FIX_EVERY == 0
     fix[:k0] = False

@@ -2,7 +2,10 @@
 Fossen, "Heave motion estimation on a craft using a strapdown inertial measurement unit").
 
 Heave (positive down, NED, relative to the mean position) is estimated from the vertical
-acceleration with no model of the craft, in the paper's four steps:
+acceleration with no model of the craft, in the paper's four steps (the default estimator,
+``model="wiener"``, shares steps 1 and 4 and replaces 2-3 by a causal Wiener filter designed
+from the spectrum: :mod:`.wiener_heave`; :func:`~.highpass_heave.heave_estimator` builds
+whichever ``model`` names):
 
 1. **Spectrum** of the vertical acceleration over the last ``window`` seconds and the position
    spectrum A(ω) = Ä(ω)/ω² (eq. 2), :func:`~.wave_peaks.acceleration_spectrum`. Beyond the
@@ -14,7 +17,7 @@ acceleration with no model of the craft, in the paper's four steps:
 3. **Observer**: ``model="peaks"`` is the paper's, a Kalman filter over undamped oscillator
    modes at the peak frequencies plus a random-walk offset (eqs. 3-9), :mod:`.oscillator_bank`;
    exact (rotation) discretisation by default, the Euler form of eq. 9 selectable.
-   ``model="band"`` (default, beyond the paper) replaces the modes by a comb of damped band-pass
+   ``model="band"`` (beyond the paper) replaces the modes by a comb of damped band-pass
    elements spanning [``band_min``, ``omega_max``], weighted by the measured spectrum
    (:mod:`.band_bank`): the filter's model then has the sea's spectrum and no heave below the
    band, which the paper's modes lack (measured on VesselMotion, real-time RMS error at
@@ -127,11 +130,12 @@ class HeaveObserverParams:
     peak_interval : float
         Time between peak detections [s], (0, 3600] (paper: T = 15 s). [``peak_interval``]
     model : str
-        ``"band"`` (default) or ``"peaks"`` (the paper's modes), module docstring; or
-        ``"highpass"``, the classical high-pass double integration
-        (:class:`~.highpass_heave.HighpassHeave`, a baseline, not this class); or
-        ``"wiener"``, the causal Wiener filter designed from the spectrum
-        (:class:`~.wiener_heave.WienerHeave`, not this class). [``model``]
+        ``"wiener"`` (default), the causal Wiener filter designed from the spectrum
+        (:class:`~.wiener_heave.WienerHeave`, not this class: the most accurate, README);
+        ``"band"`` or ``"peaks"`` (the paper's modes), the observers of this module
+        (module docstring); or ``"highpass"``, the classical high-pass double integration
+        (:class:`~.highpass_heave.HighpassHeave`, a baseline, not this class). Build any of
+        them with :func:`~.highpass_heave.heave_estimator`. [``model``]
     max_modes : int
         Most oscillator modes, 1..20 (``model="peaks"``). [``max_modes``]
     omega_min, omega_max : float
@@ -194,7 +198,7 @@ class HeaveObserverParams:
     window: float = 120.0
     window_max: float = WINDOW_MAX
     peak_interval: float = 15.0
-    model: str = "band"
+    model: str = "wiener"
     max_modes: int = 6
     omega_min: float = 0.25
     omega_max: float = 6.0
@@ -417,21 +421,22 @@ class HeaveObserver:
     Parameters
     ----------
     params : HeaveObserverParams, optional
-        Validated parameters (defaults if omitted).
+        Validated parameters with ``model`` "band" or "peaks" (the defaults with ``model="band"``
+        if omitted).
     quiet : bool
         Log nothing (for use inside another estimator that reports for itself, such as
         :class:`~.wave_coast.WaveCoast`, where an axis without waves is normal).
 
     Examples
     --------
-    >>> obs = HeaveObserver(HeaveObserverParams(window=60.0))
+    >>> obs = HeaveObserver(HeaveObserverParams(model="band", window=60.0))
     >>> r = obs.step(-9.80665, 0.0, 0.0, 0.1)
     >>> r.valid, r.modes      # no spectrum before the first window is full
     (False, 0)
     """
 
     def __init__(self, params: HeaveObserverParams | None = None, *, quiet: bool = False) -> None:
-        self.params = params or HeaveObserverParams()
+        self.params = params or HeaveObserverParams(model="band")
         if self.params.model in ("highpass", "wiener"):
             raise ParameterError(f"model = {self.params.model!r} is not an observer model: use "
                                  "estimators.highpass_heave.heave_estimator(params)")

@@ -111,7 +111,7 @@ class WaveCoast:
 
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
-        vertical = HeaveObserverParams(smoother_lag=0.0, peak_interval=PEAK_INTERVAL, window=self.spectrum_window,
+        vertical = HeaveObserverParams(model="band", smoother_lag=0.0, peak_interval=PEAK_INTERVAL, window=self.spectrum_window,
                                        window_max=self.spectrum_window, band_min=BAND_MIN, band_variance="point")
         horizontal = replace(vertical, offset_noise=HORIZONTAL_OFFSET_NOISE)
         self.observers = [HeaveObserver(horizontal, quiet=True), HeaveObserver(horizontal, quiet=True),

@@ -74,7 +74,7 @@ def compare(hs: float = 2.5, tp: float = 9.0, duration: float = 720.0) -> dict:
     truth = {"imu": rec["truth.imu.d"] - rec["truth.imu.d"][k0:].mean(),
              "point": rec["truth.point.d"] - rec["truth.point.d"][k0:].mean()}
     runs = {}
-    for label, params in (("band", HeaveObserverParams(point=ARM)),
+    for label, params in (("band", HeaveObserverParams(point=ARM, model="band")),
                           ("peaks (paper)", HeaveObserverParams(point=ARM, model="peaks", offset_noise=3e-4,
                                                                 window_max=120.0)),    # the paper's fixed window
                           ("wiener", HeaveObserverParams(point=ARM, model="wiener"))):
@@ -112,7 +112,7 @@ def band_min_study(values: tuple[float, ...] = (0.25, 0.3, 0.35), duration: floa
     from ..peer_orcaflex import heave_scores, load_orcaflex
 
     def errors(rec: dict, band_min: float) -> dict[str, float]:
-        e = imu_error(rec, run_observer(HeaveObserverParams(point=ARM, band_min=band_min), rec)[0][:, 0])
+        e = imu_error(rec, run_observer(HeaveObserverParams(point=ARM, model="band", band_min=band_min), rec)[0][:, 0])
         f, psd = signal.welch(e, fs=1.0 / DT, nperseg=8192)
         low = 2.0 * math.pi * f < 0.2
         return {"rms_cm": 100.0 * _rms(e), "below_0.2_rad_s_cm": 100.0 * math.sqrt(float(np.sum(psd[low])) * f[1])}
@@ -136,7 +136,7 @@ def window_max_study(values: tuple[float, ...] = (120.0, 600.0), duration: float
     for hs, tp in ((4.0, 12.0), (4.0, 14.0)):
         rec = record(hs, tp, duration)
         result[f"Hs {hs:g} Tp {tp:g}"] = {
-            f"{w:g}": 100.0 * _rms(imu_error(rec, run_observer(HeaveObserverParams(point=ARM, window_max=w), rec)[0][:, 0]))
+            f"{w:g}": 100.0 * _rms(imu_error(rec, run_observer(HeaveObserverParams(point=ARM, model="band", window_max=w), rec)[0][:, 0]))
             for w in values}
     orca = load_orcaflex()
     result["OrcaFlex, true angles"] = {
