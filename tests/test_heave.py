@@ -392,10 +392,11 @@ def test_bias_step_is_absorbed_by_the_offset(record, model):
         assert np.sqrt(np.mean((out[after:, 0] - ref[after:, 0]) ** 2)) < 0.01
 
 
-@pytest.mark.parametrize("model,corr", [("peaks", 0.98), ("band", 0.99)])   # measured 0.986, 0.994
+@pytest.mark.parametrize("model,corr", [("peaks", 0.98), ("band", 0.99), ("wiener", 0.99)])
 def test_two_spectral_peaks_are_tracked(model, corr):
     """Swell (Tp 14 s) plus wind sea (Tp 5 s) on a heave-following buoy: the paper's model puts
-    a mode on each peak; both models track heave (8 minutes, scored after 2)."""
+    a mode on each peak and the Wiener filter reports each peak of its heave spectrum; every
+    model tracks heave (8 minutes, scored after 2; correlation measured 0.986 / 0.994 / 0.996)."""
     t = np.arange(1, int(480 / DT) + 1) * DT
     z, a = np.zeros_like(t), np.zeros_like(t)
     for hs, tp, stream in ((1.0, 14.0, 0), (1.5, 5.0, 1)):
@@ -406,9 +407,10 @@ def test_two_spectral_peaks_are_tracked(model, corr):
     rng = np.random.default_rng(2)
     acc = a - G + 7e-4 / math.sqrt(DT) * rng.standard_normal(len(t))
     out, obs = _run(HeaveObserverParams(model=model), acc, 0 * t, 0 * t)
-    if model == "peaks":
-        periods = 2 * math.pi / np.array(obs._result.omega)
-        assert obs._result.modes >= 2
+    if model != "band":
+        last = obs.step(acc[-1], 0.0, 0.0, DT)
+        periods = 2 * math.pi / np.array(last.omega)
+        assert last.modes == len(periods) >= 2
         assert np.min(np.abs(periods - 14.0)) < 0.15 * 14.0 and np.min(np.abs(periods - 5.0)) < 0.15 * 5.0
     k0 = int(120 / DT)
     assert np.corrcoef(out[k0:, 0], z[k0:])[0, 1] > corr

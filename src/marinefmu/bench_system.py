@@ -11,7 +11,7 @@ in-process without FMI, ``SystemRunner(engine="python")``) or ``libcosim`` (OSP 
 the scenario's ``OspSystemStructure.xml``), the ``system`` scenario at its 100 Hz base step
 (optionally in another sea: Hs [m], Tp [s]), its ``[record]`` list streamed to
 ``OUT_DIR/results.npy`` (libcosim: sampled every second). It prints one JSON line: wall time
-[s], real-time factor, peak resident memory [MB] (``ru_maxrss``) and, for the runners that
+[s], real-time factor, peak resident memory [MB] (:func:`peak_rss_mb`) and, for the runners that
 record every step, the accuracy table of :func:`marinefmu.scoring.score` and each component's
 mean wall time per base step in its ``doStep`` [µs] (``SystemRunner.step_seconds``).
 """
@@ -43,7 +43,18 @@ def _system(hs: float | None, tp: float | None):
     return replace(sc, system=replace(sc.system, components=comps))
 
 
-def _peak_rss_mb() -> float:
+def peak_rss_mb() -> float:
+    """Peak resident memory of this process's own image [MB]: ``VmHWM`` of /proc/self/status,
+    which starts afresh at ``exec``. Not ``ru_maxrss``: Linux keeps that across ``execve``, so
+    a worker started by a large parent (the bench after its OrcaFlex and accuracy parts: 313 MB
+    on 2026-11-23) reported the parent's peak as its own. ``ru_maxrss`` where /proc is absent."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
@@ -65,14 +76,14 @@ def measure(engine: str, fmu_dir: str, duration: float, out_dir: str, hs: float 
         from .cosim.libcosim_runner import run_libcosim
 
         run_libcosim(sc.system, fmu_dir, out, duration, list(sc.record), 1.0)
-        wall, peak = time.perf_counter() - t0, _peak_rss_mb()
+        wall, peak = time.perf_counter() - t0, peak_rss_mb()
     else:
         from .cosim.system import SystemRunner
         from .scoring import score
 
         runner = SystemRunner(sc.system, fmu_dir, engine=engine)
         result = runner.run(duration, record=sc.record, progress=False, out_file=out / "results.npy")
-        wall, peak = time.perf_counter() - t0, _peak_rss_mb()
+        wall, peak = time.perf_counter() - t0, peak_rss_mb()
         steps = {name: 1e6 * sec / (len(result) - 1) for name, sec in runner.step_seconds.items()}
         scores = score(result, sc.system, "vessel") if scored else {}
     return {"engine": engine, "duration_s": duration, "wall_s": wall, "rtf": duration / wall,

@@ -385,11 +385,12 @@ class HeaveResult:
         Offset state [m/s²] (accelerometer bias along the vertical; ``vertical="paper"``: plus
         −g cosθ cosφ).
     modes : int
-        Number of oscillator modes (0 before the first spectrum).
+        Number of oscillator modes (0 before the first spectrum; ``model="wiener"``: of peaks
+        of the sea's heave spectrum, the filter has no modes).
     peak_period : float
         Period of the highest peak of A(ω) [s] (0 before the first spectrum).
     omega : tuple of float
-        Mode frequencies [rad/s].
+        Mode frequencies [rad/s] (``model="wiener"``: the peaks').
     valid : bool
         Modes found and the sample good.
     delayed_valid : bool

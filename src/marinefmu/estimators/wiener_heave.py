@@ -24,7 +24,9 @@ Design, at every ``peak_interval`` after the first ``window`` (the window grows 
    cross-correlation of the wanted output with ā, r(τ) = Σ S_z |B| Δω cos(ω(τ − ℓ) − ∠B) with
    B(ω) = −ω² times the block mean's response (for the rate, ω S_z and ∠B − π/2), for heave and
    heave rate now (ℓ = 0) and ``smoother_lag`` s ago (the delayed outputs, ℓ = the lag: the
-   same R, two more right-hand sides). :func:`wiener_taps`.
+   same R, two more right-hand sides). R also holds the measured acceleration above
+   ``omega_max`` (up to the block mean's first null), which is not heave to estimate, so the
+   filter does not amplify it. :func:`wiener_taps`.
 3. Every step, the four outputs are the weights applied to the block means ending at the
    newest sample (a full-rate FIR of MEMORY/Δt taps, each block's weight spread over its
    samples, computed as differences of a running sum: L + 1 reads instead of L·M multiplies)
@@ -47,6 +49,7 @@ from __future__ import annotations
 
 import logging
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -54,7 +57,7 @@ from scipy.linalg import solve_toeplitz
 
 from .heave import HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, read_and_start, \
     vertical_acceleration
-from .wave_peaks import Spectrum, acceleration_spectrum, band_integral
+from .wave_peaks import Spectrum, acceleration_spectrum, band_integral, find_modes
 
 log = logging.getLogger(__name__)
 
@@ -69,6 +72,17 @@ MEMORY = 180.0
 #: 2.86 / 2.77 / 2.74; a fixed 0.025 / 0.05 / 0.1 / 0.2 rad/s: 2.24 / 2.15 / 2.23 / 2.70 and
 #: 2.97 / 2.80 / 2.82 / 3.24. Relative 0.1 is also no worse on the other seas of the checks.
 SMOOTHING = 0.1
+
+
+def excess_acceleration(spectrum: Spectrum, acc_noise: float, offset_noise: float,
+                        smoothing: float = SMOOTHING) -> np.ndarray:
+    """The acceleration density above the sensor's noise, max(⟨S_ä − S_n⟩, 0)
+    [(m/s²)²/(rad/s)], at the spectrum's frequencies (arguments as :func:`sea_heave_density`)."""
+    omega = spectrum.omega
+    noise = (acc_noise**2 + offset_noise**2 / omega**2) / math.pi
+    half = np.maximum(0.5 * smoothing * omega, 0.5 * (omega[1] - omega[0]))
+    excess = band_integral(omega, spectrum.acc_density - noise, omega - half, omega + half) / (2.0 * half)
+    return np.maximum(excess, 0.0)
 
 
 def sea_heave_density(spectrum: Spectrum, acc_noise: float, offset_noise: float, omega_min: float,
@@ -90,16 +104,13 @@ def sea_heave_density(spectrum: Spectrum, acc_noise: float, offset_noise: float,
         least one bin; :data:`SMOOTHING`).
     """
     omega = spectrum.omega
-    noise = (acc_noise**2 + offset_noise**2 / omega**2) / math.pi
-    half = np.maximum(0.5 * smoothing * omega, 0.5 * (omega[1] - omega[0]))
-    excess = band_integral(omega, spectrum.acc_density - noise, omega - half, omega + half) / (2.0 * half)
-    sea = np.maximum(excess, 0.0) / omega**4
+    sea = excess_acceleration(spectrum, acc_noise, offset_noise, smoothing) / omega**4
     sea[(omega < omega_min) | (omega > omega_max)] = 0.0
     return sea
 
 
 def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: int, taps: int, lag: float,
-                acc_noise: float, offset_noise: float) -> np.ndarray:
+                acc_noise: float, offset_noise: float, unwanted: np.ndarray | None = None) -> np.ndarray:
     """Step 2: the weights of the four outputs on the block means.
 
     Parameters
@@ -119,6 +130,13 @@ def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: 
         Delay of the delayed outputs [s].
     acc_noise, offset_noise : float
         As :func:`sea_heave_density`.
+    unwanted : numpy.ndarray, optional
+        (K,) acceleration density on ``omega`` that is not heave to estimate [(m/s²)²/(rad/s)]:
+        the measured excess above ``omega_max`` (short waves a buoy follows, vibration). It
+        enters the autocorrelation only, up to 2π/(M·Δt), the block mean's first null (beyond
+        it the block mean passes ≤ 5 % of the power), so the filter does not amplify it:
+        without it, a wind sea reaching 6.3 rad/s with ``omega_max`` 6 met a gain of 165 at
+        6.5 rad/s and its heave was 0.9 m wrong on a 0.45 m std (test).
 
     Returns
     -------
@@ -129,13 +147,17 @@ def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: 
     """
     memory = taps * block * dt
     top = float(np.max(omega[heave_density > 0.0], initial=omega[0]))
+    if unwanted is not None:
+        first_null = 2.0 * math.pi / (block * dt)
+        top = max(top, min(float(np.max(omega[unwanted > 0.0], initial=omega[0])), first_null))
     d_omega = min(omega[1] - omega[0], math.pi / (2.0 * memory))    # correlations periodic in 4× the memory
     w = np.arange(omega[0], top + d_omega, d_omega)
     s_z = np.interp(w, omega, heave_density)
+    extra = np.zeros_like(w) if unwanted is None else np.interp(w, omega, unwanted)
     mean_response = np.exp(-1j * np.outer(w, np.arange(block) * dt)).mean(axis=1)
     b = -(w**2) * mean_response
     tau = np.arange(taps) * block * dt
-    acc_density = np.abs(mean_response) ** 2 * (s_z * w**4 + offset_noise**2 / (math.pi * w**2))
+    acc_density = np.abs(mean_response) ** 2 * (s_z * w**4 + extra + offset_noise**2 / (math.pi * w**2))
     auto = (acc_density * d_omega) @ np.cos(np.outer(w, tau))
     auto[0] += acc_noise**2 / (block * dt)
     cross = []
@@ -157,7 +179,9 @@ class WienerHeave:
     params : HeaveObserverParams, optional
         Uses ``window``, ``window_max``, ``peak_interval``, ``omega_min``, ``omega_max``,
         ``acc_noise``, ``offset_noise``, ``smoother_lag``, ``vertical``, ``transfer`` and
-        ``point`` (``model`` is ignored).
+        ``point``; ``max_modes``, ``min_separation`` and ``min_relative`` for the peaks of the
+        sea's heave spectrum reported as ``modes`` and ``omega`` (the filter has no modes;
+        :func:`~.wave_peaks.find_modes` on √S_z: swell and wind sea). ``model`` is ignored.
     quiet : bool
         Log nothing.
 
@@ -187,6 +211,7 @@ class WienerHeave:
         self.total = 0.0                     # the running sum at the newest sample
         self.mean = 0.0
         self.peak_period = 0.0
+        self.peaks: tuple[float, ...] = ()   # frequencies of the sea's spectral peaks [rad/s]
 
     def _start(self, dt: float) -> None:
         p = self.params
@@ -224,15 +249,21 @@ class WienerHeave:
         self.sum_buf -= self.total          # keep the running sum near zero: its differences are unchanged
         self.total = 0.0
         spectrum = acceleration_spectrum(win, self.dt)
-        sea = sea_heave_density(spectrum, p.acc_noise, p.offset_noise, p.omega_min, p.omega_max, SMOOTHING)
+        excess = excess_acceleration(spectrum, p.acc_noise, p.offset_noise, SMOOTHING)
+        sea = np.where((spectrum.omega >= p.omega_min) & (spectrum.omega <= p.omega_max), excess / spectrum.omega**4,
+                       0.0)
         if not np.any(sea > 0.0):
             self.log.warning("wiener heave: no sea above the noise in [%g, %g] rad/s; filter unchanged",
                              p.omega_min, p.omega_max)
             return
         self.peak_period = 2.0 * math.pi / float(spectrum.omega[np.argmax(sea)])
+        found = find_modes(replace(spectrum, position_amplitude=np.sqrt(sea)), p.omega_min, p.omega_max,
+                           p.max_modes, p.min_separation, p.min_relative)
+        self.peaks = tuple(float(w) for w in found.omega)
         blocks = min(self.blocks, self.k // self.block)           # no further back than the data
+        above = np.where(spectrum.omega > p.omega_max, excess, 0.0)
         self.taps = np.ascontiguousarray(wiener_taps(spectrum.omega, sea, self.dt, self.block, blocks, self.delay,
-                                                     p.acc_noise, p.offset_noise) / self.block)  # as restored
+                                                     p.acc_noise, p.offset_noise, above) / self.block)  # as restored
         self.tap_sums = self.taps.sum(axis=1) * self.block
         self.mean = float(win.mean())
 
@@ -278,7 +309,8 @@ class WienerHeave:
         d_point, _ = point_heave(d_heave, d_rate, p.point, *old[-1], *backward_rate(old, self.dt), p.transfer)
         delayed_valid = self.k * self.dt >= p.window + self.delay
         return HeaveResult(float(heave), float(rate), ph, pr, float(d_heave), float(d_rate), d_point, self.delay,
-                           self.mean, 0, self.peak_period, (), warning is None, delayed_valid, warning)
+                           self.mean, len(self.peaks), self.peak_period, self.peaks, warning is None, delayed_valid,
+                           warning)
 
     def get_state(self) -> dict:
         """JSON-serialisable state."""
@@ -287,7 +319,7 @@ class WienerHeave:
         return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect, "spectrum_buf": arr(self.spectrum_buf),
                 "sum_buf": arr(self.sum_buf), "total": self.total, "angle_buf": arr(self.angle_buf),
                 "taps": arr(self.taps),
-                "mean": self.mean, "peak_period": self.peak_period}
+                "mean": self.mean, "peak_period": self.peak_period, "peaks": list(self.peaks)}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -303,3 +335,4 @@ class WienerHeave:
             self.taps = np.array(s["taps"], dtype=float)
             self.tap_sums = self.taps.sum(axis=1) * self.block
         self.mean, self.peak_period = float(s["mean"]), float(s["peak_period"])
+        self.peaks = tuple(float(w) for w in s["peaks"])
