@@ -76,8 +76,9 @@ def test_whole_system_runs_the_same_under_fmpy_and_libcosim(fmu_dir, tmp_path):
     s = score(full, system, "vessel", settle=60.0)
     # measured 2026-11-22 (scored from 60 s after valid, against the truth one step earlier), with
     # the scenario's attitude aiding sized for the sea: roll / pitch ~0.03 deg (0.059 / 0.064 with
-    # the estimator's defaults), fusion 0.29 / 0.27 / 0.30 cm, heave 0.87 cm at the IMU (std 35 cm; 2026-11-23, the Wiener default;
-    # ~1.1 with the band observer) and 3.4 cm at the bow point (6.8 cm with the defaults)
+    # the estimator's defaults), fusion 0.29 / 0.27 / 0.30 cm, heave 0.87 cm at the IMU (std 35 cm;
+    # 2026-11-23, the Wiener default; ~1.1 with the band observer) and 3.4 cm at the bow point
+    # (6.8 cm with the defaults)
     assert s["att"]["roll_deg"] < 0.05 and s["att"]["pitch_deg"] < 0.05    # with the AttitudeEstimator's angles
     assert max(s["fusion"][f"pos_{a}_cm"] for a in "ned") < 0.4           # 5 Hz RTK GNSS
     # issue 4's goal, fused ≤ 0.5 × raw GNSS: the COG fixed from the four antennas alone at each
