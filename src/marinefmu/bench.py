@@ -275,7 +275,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     part keeps its own date and machine, so parts can be re-measured one at a time) and print
     what they measure; return the whole file's data.
 
-    ``speed`` takes a few minutes, ``heave`` about fifteen (seven seas with their causal bounds, the ``band_min`` and ``window_max`` studies), ``peer`` about one, ``orcaflex`` a
+    ``speed`` takes a few minutes, ``heave`` about twenty (seven seas with their causal bounds, the ``band_min`` and ``window_max`` studies), ``peer`` about one, ``orcaflex`` a
     few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 40 GNSS dropouts of 30 s and 4 of 5 min) about five, ``system`` (three seas, three engines and a 3-hour run) about an hour,
     ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
     2-core machine."""
