@@ -135,3 +135,38 @@ def test_model_switch():
         HeaveObserver(HeaveObserverParams(model="wiener"))
     with pytest.raises(ParameterError, match="model = 'kalman' is not allowed"):
         HeaveObserverParams(model="kalman")
+
+
+def test_bias_step_search_is_the_least_squares_hinge_fit():
+    """The closed-form search (:mod:`marinefmu.estimators.bias_step`) against the hinge fit done
+    by numpy's least squares, candidate by candidate: the same size at every candidate (1e-9),
+    the same best candidate, found where the step is; no step in the same data without it; a
+    step younger than 5 s is not yet reported (a fit limited to older kinks would misplace it)."""
+    from marinefmu.estimators.bias_step import MIN_AGE, find_bias_step
+
+    rng = np.random.default_rng(4)
+    dt, n = 0.05, 12000                                   # 600 s, 600 blocks of 1 s
+    t = np.arange(n) * dt
+    sea = 0.4 * np.sin(0.8 * t + 1.0) + 0.2 * np.sin(1.3 * t) + 0.01 * rng.standard_normal(n)
+    step = np.where(t >= 450.0, 0.08, 0.0)
+    a = sea + step
+    blocks = a.reshape(600, 20).mean(axis=1)
+    v = np.cumsum(blocks - blocks.mean())
+    j = np.arange(600.0)
+    sizes, reductions = [], []
+    for s in range(60, 598):
+        x = np.column_stack([np.ones(600), j, np.maximum(j - s, 0.0)])
+        coef, *_ = np.linalg.lstsq(x, v, rcond=None)
+        base, *_ = np.linalg.lstsq(x[:, :2], v, rcond=None)
+        sizes.append(coef[2])
+        reductions.append(np.sum((v - x[:, :2] @ base) ** 2) - np.sum((v - x @ coef) ** 2))
+        assert find_bias_step(a, dt, at=(s + 1) * 20).size == pytest.approx(coef[2], abs=1e-9)
+    found = find_bias_step(a, dt)
+    assert found.index == (60 + int(np.argmax(reductions)) + 1) * 20 == 9000      # t = 450 s
+    assert found.size == pytest.approx(0.08, abs=1e-3)
+    assert find_bias_step(sea, dt) is None
+    t = np.arange(int(620 / dt)) * dt                                 # a longer sea, a step at 600 s
+    young = 0.4 * np.sin(0.8 * t + 1.0) + 0.2 * np.sin(1.3 * t) + np.where(t >= 600.0, 0.5, 0.0)
+    assert find_bias_step(young[:int(602.5 / dt)], dt) is None                  # 2.5 s old
+    old = find_bias_step(young[int(12.5 / dt):int(612.5 / dt)], dt)             # 12.5 s old
+    assert old.index * dt + 12.5 == pytest.approx(600.0, abs=1.0) and old.size == pytest.approx(0.5, abs=0.05)

@@ -10,7 +10,7 @@ of three repetitions of ``steps`` steps at Δt = 0.01 s with 200 wave components
 - ``in_process``: ``VesselMotionModel.step`` without FMI;
 - ``system_runner``: the FMPy system master recording every output.
 
-Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_accuracy`, each beside its causal bound) and its ``band_min`` and ``window_max`` studies,
+Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_accuracy`, each beside its causal bound), its ``band_min`` and ``window_max`` studies and a bias step in mid-run,
 marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
 (``orcaflex``), the GNSS dropout coast of paper 001 over 40 dropouts (``dropout``,
 :func:`marinefmu.examples.paper001.dropouts`), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
@@ -221,6 +221,19 @@ def heave_window_max() -> dict[str, dict]:
     return result
 
 
+def heave_bias_step() -> dict[str, dict]:
+    """The heave estimators after a bias step in mid-run
+    (:func:`marinefmu.examples.paper003.bias_step_study`), printed: RMS error at the IMU [cm] per
+    window after the step."""
+    from .examples import paper003
+
+    result = paper003.bias_step_study()
+    for case, row in result.items():
+        print(f"heave bias step, Hs 2.5 Tp 9, step at 900 s, {case}: " + "; ".join(
+            f"{w} {cm:.2f} cm" for w, cm in row.items()), flush=True)
+    return result
+
+
 def heave_band_min() -> dict[str, dict]:
     """The heave observer's ``band_min`` study (:func:`marinefmu.examples.paper003.band_min_study`),
     printed: RMS error at the IMU [cm] (and below 0.2 rad/s) per case and ``band_min``."""
@@ -299,7 +312,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             data.update(speed(fmu_dir, steps), **stamp)  # the speed figures stay at the top level
         elif part == "heave":
             data["heave"] = {**stamp, "seas": heave_accuracy(), "band_min": heave_band_min(),
-                             "window_max": heave_window_max()}
+                             "window_max": heave_window_max(), "bias_step": heave_bias_step()}
         elif part == "peer":
             data["peer"] = {**stamp, "seas": peer_comparison()}
         elif part == "orcaflex":

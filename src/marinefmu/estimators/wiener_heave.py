@@ -33,6 +33,16 @@ Design, at every ``peak_interval`` after the first ``window`` (the window grows 
    of the acceleration less the window's mean (the ``offset`` output; it removes a bias or a
    bias step once the window has seen it).
 
+Bias steps. The output has no gain at zero frequency, so a constant bias never reaches it, but a
+bias *step* in mid-run would stay in the spectrum window as a 1/ω² density, taken for sea at low
+frequency until it left the window 20 minutes later (on Hs 2.5 / Tp 9 after 0.5 m/s²: 59 cm RMS in
+the second minute, 2.8 cm at 5-10 minutes; README). So every :data:`STEP_CHECK` s the window is
+searched for a step (:func:`~.bias_step.find_bias_step`: the kink it puts into the integrated
+acceleration); one found is taken out of the window and of the filter's input from its first
+sample on, and of every sample to come (the ``offset`` output includes it), and its size is
+estimated again at every check for :data:`STEP_REFINE_AGE` s as the record after it grows. The
+heave is then the heave of the run without the step (test). A warning is logged for each step.
+
 Measured (a scan, 2026-11-23, seed 3, 30 min after 2 min, real-time heave RMS error at the IMU
 [cm]; band observer → this, causal bound): Hs 4 / Tp 6 0.49 → 0.36 (0.35); Hs 2.5 / Tp 9
 1.03 → 0.87 (0.80); Hs 4 / Tp 12 2.31 → 2.00 (1.87); Hs 4 / Tp 14 2.96 → 2.64 (2.42), figures
@@ -57,6 +67,7 @@ from scipy.linalg import solve_toeplitz
 
 from .heave import HeaveObserverParams, HeaveResult, _Silent, backward_rate, point_heave, read_and_start, \
     vertical_acceleration
+from .bias_step import BiasStep, find_bias_step
 from .wave_peaks import Spectrum, acceleration_spectrum, band_integral, find_modes
 
 log = logging.getLogger(__name__)
@@ -72,6 +83,12 @@ MEMORY = 180.0
 #: 2.86 / 2.77 / 2.74; a fixed 0.025 / 0.05 / 0.1 / 0.2 rad/s: 2.24 / 2.15 / 2.23 / 2.70 and
 #: 2.97 / 2.80 / 2.82 / 3.24. Relative 0.1 is also no worse on the other seas of the checks.
 SMOOTHING = 0.1
+#: Interval of the search for a bias step in the buffered window (:mod:`.bias_step`) [s].
+STEP_CHECK = 1.0
+#: A step found is estimated again at every check until it is this old [s] …
+STEP_REFINE_AGE = 600.0
+#: … and the difference taken out when it reaches this [m/s²].
+STEP_REFINE_MIN = 1e-4
 
 
 def excess_acceleration(spectrum: Spectrum, acc_noise: float, offset_noise: float,
@@ -210,6 +227,8 @@ class WienerHeave:
         self.tap_sums = np.zeros(4)          # the taps' sums over the samples
         self.total = 0.0                     # the running sum at the newest sample
         self.mean = 0.0
+        self.level = 0.0                     # bias steps found and taken out of the buffers [m/s²]
+        self.step_at: int | None = None      # sample index of the last step found (refined as it ages)
         self.peak_period = 0.0
         self.peaks: tuple[float, ...] = ()   # frequencies of the sea's spectral peaks [rad/s]
 
@@ -224,6 +243,7 @@ class WienerHeave:
         self.sum_buf = np.zeros(2 * (self.n_fir + 1))
         self.angle_buf = np.zeros((self.lag_steps + 3, 2))
         self.next_detect = int(round(p.window / dt))
+        self.check_every = max(1, int(round(STEP_CHECK / dt)))
 
     @property
     def delay(self) -> float:
@@ -267,6 +287,40 @@ class WienerHeave:
         self.tap_sums = self.taps.sum(axis=1) * self.block
         self.mean = float(win.mean())
 
+    def _check_bias_step(self) -> None:
+        """Look for a bias step in the window (:func:`~.bias_step.find_bias_step`) and take it
+        out; else estimate the last one's size again on the longer record since it (its first
+        estimate, made early, errs by about √2 σ_v / its age) and take out the difference."""
+        win = self._window()
+        first = self.k - len(win)
+        found = find_bias_step(win, self.dt)
+        if found is not None:
+            self._relevel(found, first)
+            self.step_at = first + found.index
+            self.log.warning("wiener heave: a bias step of %+.4f m/s² at t = %.1f s (%.0f s ago, z = %.1f) found "
+                             "and taken out", found.size, self.step_at * self.dt, (self.k - self.step_at) * self.dt,
+                             found.z)
+        elif self.step_at is not None:
+            if self.step_at <= first or (self.k - self.step_at) * self.dt > STEP_REFINE_AGE:
+                self.step_at = None
+                return
+            again = find_bias_step(win, self.dt, at=self.step_at - first)
+            if again is not None and abs(again.size) >= STEP_REFINE_MIN:
+                self._relevel(again, first)
+
+    def _relevel(self, found: BiasStep, first: int) -> None:
+        """Take a bias step out of the buffers, from its first sample on (``first``: the
+        absolute index of the window's oldest sample), and out of every sample to come."""
+        start, size = first + found.index, found.size
+        n = len(self.spectrum_buf)
+        self.spectrum_buf[np.arange(max(start, self.k - n), self.k) % n] -= size
+        n_sum = self.n_fir + 1
+        stored = np.arange(max(start, self.k - n_sum), self.k)
+        for offset in (0, n_sum):
+            self.sum_buf[stored % n_sum + offset] -= size * (stored - start + 1)
+        self.total -= size * (self.k - start)
+        self.level += size
+
     def response(self, omega: Any) -> np.ndarray | None:
         """Heave response H(e^{jωΔt}) of the current filter: the real-time heave estimate of a
         noise-free sinusoidal heave at ω [rad/s] is H(ω) times the truth (the filter sees −ω²
@@ -284,7 +338,7 @@ class WienerHeave:
         p = self.params
         f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
         if warning is None:
-            a_v = vertical_acceleration(f, roll, pitch, p.vertical)
+            a_v = vertical_acceleration(f, roll, pitch, p.vertical) - self.level
         else:
             self.log.warning("wiener heave: %s; the window's mean acceleration used", warning)
             a_v = self.mean
@@ -296,6 +350,8 @@ class WienerHeave:
         self.sum_buf[i] = self.sum_buf[i + n_sum] = self.total
         self.angle_buf[self.k % len(self.angle_buf)] = (roll, pitch)
         self.k += 1
+        if self.k % self.check_every == 0:
+            self._check_bias_step()
         if self.k >= self.next_detect:
             self._design()
         if self.taps is None:
@@ -309,8 +365,8 @@ class WienerHeave:
         d_point, _ = point_heave(d_heave, d_rate, p.point, *old[-1], *backward_rate(old, self.dt), p.transfer)
         delayed_valid = self.k * self.dt >= p.window + self.delay
         return HeaveResult(float(heave), float(rate), ph, pr, float(d_heave), float(d_rate), d_point, self.delay,
-                           self.mean, len(self.peaks), self.peak_period, self.peaks, warning is None, delayed_valid,
-                           warning)
+                           self.level + self.mean, len(self.peaks), self.peak_period, self.peaks, warning is None,
+                           delayed_valid, warning)
 
     def get_state(self) -> dict:
         """JSON-serialisable state."""
@@ -319,7 +375,7 @@ class WienerHeave:
         return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect, "spectrum_buf": arr(self.spectrum_buf),
                 "sum_buf": arr(self.sum_buf), "total": self.total, "angle_buf": arr(self.angle_buf),
                 "taps": arr(self.taps),
-                "mean": self.mean, "peak_period": self.peak_period, "peaks": list(self.peaks)}
+                "mean": self.mean, "level": self.level, "step_at": self.step_at, "peak_period": self.peak_period, "peaks": list(self.peaks)}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -334,5 +390,6 @@ class WienerHeave:
         if s["taps"] is not None:
             self.taps = np.array(s["taps"], dtype=float)
             self.tap_sums = self.taps.sum(axis=1) * self.block
-        self.mean, self.peak_period = float(s["mean"]), float(s["peak_period"])
+        self.mean, self.level, self.peak_period = float(s["mean"]), float(s["level"]), float(s["peak_period"])
+        self.step_at = None if s["step_at"] is None else int(s["step_at"])
         self.peaks = tuple(float(w) for w in s["peaks"])

@@ -151,6 +151,33 @@ def window_max_study(values: tuple[float, ...] = (120.0, 600.0, 1200.0), duratio
     return result
 
 
+#: Windows after a bias step scored by :func:`bias_step_study` [s after the step].
+STEP_WINDOWS = ((0.0, 60.0), (60.0, 120.0), (120.0, 300.0), (300.0, 600.0), (600.0, 1200.0), (1200.0, 1500.0))
+
+
+def bias_step_study(steps: tuple[float, ...] = (0.05, 0.5), at: float = 900.0, hs: float = 2.5, tp: float = 9.0,
+                    duration: float = 2500.0) -> dict:
+    """Real-time heave RMS error at the IMU [cm] per window after a bias step in mid-run
+    (:data:`STEP_WINDOWS`), for the band observer and the Wiener filter: the checks' record
+    (seed 3) with ``step`` m/s² added to the body-z specific force from ``at`` s, beside the
+    same record without a step (``"before"``: from :data:`SETTLE` to the step). The truth's
+    mean is removed as in the checks."""
+    clean = record(hs, tp, duration)
+    k0, k_step = int(SETTLE / DT), int(at / DT)
+    truth = clean["truth.imu.d"] - clean["truth.imu.d"][k0:].mean()
+    t = np.arange(1, len(truth) + 1) * DT
+    result: dict = {}
+    for step in (0.0, *steps):
+        rec = dict(clean)
+        rec["imu.acc.z"] = clean["imu.acc.z"] + np.where(t > at, step, 0.0)
+        for model in ("band", "wiener"):
+            e = run_observer(HeaveObserverParams(model=model), rec)[0][:, 0] - truth
+            row = {"before": 100.0 * _rms(e[k0:k_step])}
+            row.update({f"{a:g}-{b:g} s": 100.0 * _rms(e[(t > at + a) & (t <= at + b)]) for a, b in STEP_WINDOWS})
+            result[f"{step:g} m/s2, {model}"] = row
+    return result
+
+
 #: Seeds of the records that train :func:`causal_bound` (the checks' record is seed 3).
 BOUND_TRAINING_SEEDS = (4, 5, 6)
 
