@@ -27,8 +27,8 @@ a 10 ms step they move by less than 1e-3 of their swing between the ends). Other
 classical Runge-Kutta 4 on substeps of at most ``max_substep`` s (the wire-load mode is
 ω = √(k/m), 10 rad/s for the defaults; RK4 at 2 ms resolves it to 1e-9); the clips are
 continuous functions of the state, the stroke stops are applied after each substep. The two
-agree to 1e-9 m where both apply (test); the exact step is ~10× cheaper, and a winch at sea
-spends almost all its steps there. The RK4 is hand-written (not ``scipy.integrate.solve_ivp``):
+agree to 2e-9 m where both apply (test); a step costs 23 µs instead of 65 µs with RK4 (measured
+2026-11-23), and a winch at sea spends almost all its steps in the linear regime. The RK4 is hand-written (not ``scipy.integrate.solve_ivp``):
 a fixed-step co-simulation slave advances by a known step and must be cheap and deterministic.
 """
 from __future__ import annotations

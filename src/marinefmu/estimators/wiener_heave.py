@@ -30,8 +30,8 @@ Design, at every ``peak_interval`` after the first ``window`` (the window grows 
 3. Every step, the four outputs are the weights applied to the block means ending at the
    newest sample (a full-rate FIR of MEMORY/Δt taps, each block's weight spread over its
    samples, computed as differences of a running sum: L + 1 reads instead of L·M multiplies)
-   of the acceleration less the window's mean (the ``offset`` output; it removes a bias or a
-   bias step once the window has seen it).
+   of the acceleration less the window's mean (with the bias steps found, the ``offset``
+   output; the weights sum to zero, so it changes no output).
 
 Bias steps. The output has no gain at zero frequency, so a constant bias never reaches it, but a
 bias *step* in mid-run would stay in the spectrum window as a 1/ω² density, taken for sea at low
@@ -375,7 +375,8 @@ class WienerHeave:
         return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect, "spectrum_buf": arr(self.spectrum_buf),
                 "sum_buf": arr(self.sum_buf), "total": self.total, "angle_buf": arr(self.angle_buf),
                 "taps": arr(self.taps),
-                "mean": self.mean, "level": self.level, "step_at": self.step_at, "peak_period": self.peak_period, "peaks": list(self.peaks)}
+                "mean": self.mean, "level": self.level, "step_at": self.step_at, "peak_period": self.peak_period,
+                "peaks": list(self.peaks)}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
