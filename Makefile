@@ -19,8 +19,10 @@ fmus: $(STAMP)
 demo: fmus
 	$(VENV)/bin/marinefmu simulate system --out results/system
 
+# Two test workers (pytest-xdist), one per core of the CI machine; a file's tests stay together so
+# its module fixtures (the conformance runs, the long co-simulations) are built once.
 test: fmus
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2 --dist loadfile
 
 bench: fmus
 	$(VENV)/bin/marinefmu bench --out bench

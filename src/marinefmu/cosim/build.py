@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pythonfmu
+from filelock import FileLock
 
 from ..errors import MarineFmuError
 from .units import postprocess_model_description
@@ -118,14 +119,18 @@ def build_all(models: Path | None = None, dest: Path | None = None, force: bool 
     scripts = sorted(p for p in models.glob("*.py") if not p.name.startswith("_"))
     if not scripts:
         raise BuildError(f"no model scripts in {models}")
+    dest.mkdir(parents=True, exist_ok=True)
     sys.path.insert(0, str(models))
+    # One builder at a time per folder: parallel test workers (make test runs two) or two shells
+    # would otherwise write the same .fmu at once, or one would read an FMU half written.
     try:
-        results = []
-        for script in scripts:
-            result = build_one(script, dest, force)
-            if verbose:
-                print(f"{'built  ' if result.rebuilt else 'up to date'} {result.fmu}")
-            results.append(result)
-        return results
+        with FileLock(dest / ".build.lock"):
+            results = []
+            for script in scripts:
+                result = build_one(script, dest, force)
+                if verbose:
+                    print(f"{'built  ' if result.rebuilt else 'up to date'} {result.fmu}")
+                results.append(result)
+            return results
     finally:
         sys.path.remove(str(models))
