@@ -241,3 +241,24 @@ def test_streamed_result_equals_the_in_memory_one(fmu_dir, tmp_path, monkeypatch
     np.testing.assert_array_equal(streamed, mem)
     np.testing.assert_array_equal(np.load(tmp_path / "r.npy"), mem)
     assert mem["vessel.gnss.valid"].dtype == bool and mem["vessel.gnss.valid"].any()
+
+
+def test_two_builders_of_one_folder_take_turns(tmp_path):
+    """make test's two workers (or two shells) may build at once: the folder's lock makes one
+    build while the other waits and then finds the FMU up to date, never half written."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    models = tmp_path / "models"
+    models.mkdir()
+    shutil.copy(Path(__file__).parent / "models" / "MfTestRelay.py", models)
+    dest = tmp_path / "fmus"
+    code = ("import sys\nfrom pathlib import Path\nfrom marinefmu.cosim.build import build_all\n"
+            f"print([r.rebuilt for r in build_all(Path({str(models)!r}), Path({str(dest)!r}), verbose=False)])\n")
+    procs = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for _ in range(2)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], [err[-2000:] for _, err in outs]
+    assert sorted(out.strip() for out, _ in outs) == ["[False]", "[True]"]
