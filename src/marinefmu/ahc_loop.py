@@ -131,9 +131,7 @@ def subsystem(system: SystemDescription, keep: set[str], overrides: dict[str, di
               stop_time: float | None = None) -> SystemDescription:
     """``system`` restricted to the components ``keep`` (and the connections among them), with
     parameter ``overrides`` per component."""
-    overrides = overrides or {}
-    comps = tuple(replace(c, parameters={**c.parameters, **overrides.get(c.name, {})})
-                  for c in system.components if c.name in keep)
+    comps = tuple(c for c in system.with_parameters(overrides or {}).components if c.name in keep)
     conns = tuple(c for c in system.connections if c.start in keep and c.end in keep)
     return replace(system, components=comps, connections=conns,
                    stop_time=system.stop_time if stop_time is None else stop_time)

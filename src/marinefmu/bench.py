@@ -144,7 +144,7 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
 
 
 #: Parts of ``marinefmu bench``, in the order they run.
-PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "system", "ahc", "memory")
+PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "system", "ahc", "campaign", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks, Hs [m], Tp [s]; Hs 4 / Tp 12 and
@@ -335,6 +335,10 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             from .bench_ahc import ahc_bench
 
             data["ahc"] = {**stamp, **ahc_bench(fmu_dir, out_dir)}
+        elif part == "campaign":
+            from .bench_campaign import campaign_bench
+
+            data["campaign"] = {**stamp, **campaign_bench(fmu_dir, out_dir / "campaign_runs")}
         else:
             data["memory"] = {**stamp, "steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0,
                               "fmus": memory(fmu_dir, memory_steps, memory_cycles)}

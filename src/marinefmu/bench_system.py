@@ -38,9 +38,7 @@ def _system(hs: float | None, tp: float | None):
     sc = load_scenario("system")
     if hs is None:
         return sc
-    comps = tuple(replace(c, parameters={**c.parameters, "sea.hs": hs, "sea.tp": tp}) if c.name == "vessel" else c
-                  for c in sc.system.components)
-    return replace(sc, system=replace(sc.system, components=comps))
+    return replace(sc, system=sc.system.with_parameters({"vessel": {"sea.hs": hs, "sea.tp": tp}}))
 
 
 def peak_rss_mb() -> float:
@@ -48,14 +46,24 @@ def peak_rss_mb() -> float:
     which starts afresh at ``exec``. Not ``ru_maxrss``: Linux keeps that across ``execve``, so
     a worker started by a large parent (the bench after its OrcaFlex and accuracy parts: 313 MB
     on 2026-11-23) reported the parent's peak as its own. ``ru_maxrss`` where /proc is absent."""
+    return _proc_status_mb("VmHWM") or resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def rss_mb() -> float | None:
+    """Resident memory of this process now [MB] (``VmRSS`` of /proc/self/status; None where
+    /proc is absent)."""
+    return _proc_status_mb("VmRSS")
+
+
+def _proc_status_mb(key: str) -> float | None:
     try:
         with open("/proc/self/status", encoding="ascii") as f:
             for line in f:
-                if line.startswith("VmHWM:"):
+                if line.startswith(f"{key}:"):
                     return int(line.split()[1]) / 1024.0
     except OSError:
         pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    return None
 
 
 def measure(engine: str, fmu_dir: str, duration: float, out_dir: str, hs: float | None = None,

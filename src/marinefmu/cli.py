@@ -12,6 +12,7 @@ Examples
     marinefmu example --list
     marinefmu example paper001-fig7 --out results/examples
     marinefmu design-ahc ahc --out results/ahc_design --write
+    marinefmu campaign examples/campaigns/scatter.toml --workers 2
 """
 from __future__ import annotations
 
@@ -26,6 +27,16 @@ from .errors import MarineFmuError
 
 #: Longest result also written as CSV [rows] (an hour at 100 Hz); longer runs only as .npy.
 CSV_MAX_ROWS = 360_001
+
+
+def _fmu_dir(given: str | None) -> Path:
+    """``--fmus`` if given, else the checkout's ``fmus/`` (built first where stale)."""
+    if given:
+        return Path(given)
+    from .cosim.build import build_all, repo_root
+
+    build_all(verbose=False)
+    return repo_root() / "fmus"
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
@@ -135,12 +146,7 @@ def _cmd_design_ahc(args: argparse.Namespace) -> int:
 
     scenario = load_scenario(args.scenario)
     out = Path(args.out)
-    fmu_dir = Path(args.fmus) if args.fmus else None
-    if fmu_dir is None:
-        from .cosim.build import build_all, repo_root
-
-        build_all(verbose=False)
-        fmu_dir = repo_root() / "fmus"
+    fmu_dir = _fmu_dir(args.fmus)
     controller = args.controller
     if controller is None:   # the controller fed by a heave observer (not the classical filter)
         kinds = {c.name: c for c in scenario.system.components}
@@ -219,6 +225,43 @@ def _cmd_example(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_campaign(args: argparse.Namespace) -> int:
+    from .campaign import load_spec, run_campaign
+    from .campaign.plots import plot_campaign
+    from .campaign.table import columns, read_log, read_table
+
+    if args.workers is not None and args.workers < 1:
+        raise MarineFmuError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+    fmu_dir = _fmu_dir(args.fmus)
+    spec = load_spec(args.spec, fmu_dir)   # every refusal before anything runs
+    out = Path(args.out or f"results/campaign/{spec.name}")
+    runs = spec.runs()
+    print(f"campaign {spec.name}: {len(runs)} run(s) of scenario {spec.scenario.name}, {spec.duration:g} s each, "
+          f"varying {', '.join(spec.axes)}; "
+          + (f"scheduler {args.scheduler}" if args.scheduler else f"local cluster of {args.workers or 'one per core'} worker(s)"))
+    try:
+        outcome = run_campaign(spec, out, fmu_dir, scheduler=args.scheduler, workers=args.workers,
+                               retry_failed=args.retry_failed, progress=not args.no_progress)
+    except KeyboardInterrupt:
+        done = read_log(out)
+        print(f"\ninterrupted: {sum(r.id in done for r in runs)} of {len(runs)} run(s) are in {out / 'results.csv'}; "
+              "run the same command again to go on", file=sys.stderr)
+        return 130
+    print(f"  {outcome.ran} run(s) now, {outcome.skipped} already in the table; {outcome.ok} succeeded, "
+          f"{outcome.failed} failed of {outcome.total}"
+          + (f"; {outcome.wall_s:.1f} s, {outcome.ran / outcome.wall_s * 3600:.0f} runs/h" if outcome.ran else ""))
+    print(f"  table {outcome.table}")
+    for rec in (r for r in read_log(out).values() if r["status"] != "ok" and r["id"] in {x.id for x in runs}):
+        print(f"  failed {rec['id']} {rec['values']}: {rec['error'][:300]}")
+    if not args.no_plots:
+        rows = read_table(outcome.table)
+        metric_cols = [c for c in columns(spec.axes, read_log(out).values(), spec.metrics)
+                       if "." in c and c not in spec.axes]
+        for path in plot_campaign(spec, rows, metric_cols, out):
+            print(f"  plot {path}")
+    return 0 if outcome.failed == 0 else 1
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``marinefmu`` console script."""
     parser = argparse.ArgumentParser(prog="marinefmu", description="Marine motion estimation FMUs: build, simulate, benchmark.")
@@ -262,6 +305,18 @@ def main(argv: list[str] | None = None) -> int:
                                                           "file (a built-in scenario: into a copy in --out)")
     a.add_argument("--no-progress", action="store_true", help="no progress bars")
     a.set_defaults(func=_cmd_design_ahc)
+    c = sub.add_parser("campaign", help="run many co-simulations of one system over a grid (sea states, seeds, "
+                                        "sensor placements) on Dask; resumable; table and accuracy maps")
+    c.add_argument("spec", help="campaign TOML file (format: marinefmu.campaign.spec)")
+    c.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
+                                       "(default: start a local cluster)")
+    c.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
+    c.add_argument("--out", help="output folder (default results/campaign/<name>); rerun into it to resume")
+    c.add_argument("--fmus", help="folder holding the FMUs (default: build into the checkout's fmus/)")
+    c.add_argument("--retry-failed", action="store_true", help="run again the runs the table holds as failed")
+    c.add_argument("--no-plots", action="store_true", help="no accuracy maps or comparisons")
+    c.add_argument("--no-progress", action="store_true", help="no progress bar")
+    c.set_defaults(func=_cmd_campaign)
     e = sub.add_parser("example", help="run one of the papers' examples (list them with --list)")
     e.add_argument("name", nargs="?", help="example name, e.g. paper001-fig7")
     e.add_argument("--list", action="store_true", help="list the examples")

@@ -89,12 +89,13 @@ def load_scenario(spec: str | Path) -> Scenario:
     return parse_scenario(text, str(path))
 
 
-def _flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+def flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Nested tables as one level of dotted keys: ``{"sea": {"hs": 2}}`` → ``{"sea.hs": 2}``."""
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
         if isinstance(v, dict):
-            out.update(_flatten(v, key + "."))
+            out.update(flatten(v, key + "."))
         else:
             out[key] = v
     return out
@@ -148,7 +149,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         params = c.get("parameters", {})
         if not isinstance(params, dict):
             raise ScenarioError(f"{source}: {where}.parameters must be a table")
-        flat = _flatten(params)
+        flat = flatten(params)
         for k, v in flat.items():
             if not isinstance(v, (bool, int, float, str)):
                 raise ScenarioError(f"{source}: {where}.parameters.{k} must be a number, boolean or string, got {v!r}")

@@ -54,6 +54,19 @@ from .cosim.ssp import SystemDescription
 HEAVE_CUTOFF = 0.2
 #: The winch's limit flags, scored as percentages of time.
 LIMIT_FLAGS = ("speed_limited", "acc_limited", "stroke_limited", "slack")
+#: Every metric :func:`score` can give, per FMU (module docstring); which ones a run gives
+#: depends on what it recorded.
+METRICS: dict[str, tuple[str, ...]] = {
+    "AttitudeEstimator": ("roll_deg", "pitch_deg"),
+    "GnssAccFusion": ("pos_n_cm", "pos_e_cm", "pos_d_cm", "raw_gnss_n_cm", "raw_gnss_e_cm", "raw_gnss_d_cm"),
+    "HeaveObserver": ("heave_cm", "heave_std_cm", "point_heave_cm", "point_heave_std_cm"),
+    "DisplacementReconstructor": ("disp_n_cm", "disp_e_cm", "disp_d_cm"),
+    "CentreOfRotation": ("cr_x_m", "cr_y_m", "cr_z_m"),
+    "AhcWinch": ("tip_heave_cm", "load_heave_cm", "residual_pct", "tip_motion_cm", "load_motion_cm",
+                 "residual_total_pct", "limited_pct", *(f"{n}_pct" for n in LIMIT_FLAGS), "vs_ideal", "vs_classical"),
+}
+#: Metrics of every scored component.
+COMMON_METRICS = ("valid_fraction", "scored_s")
 
 
 def _rms(e: np.ndarray) -> float:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import ParameterError
@@ -146,6 +146,16 @@ class SystemDescription:
             if c.name == name:
                 return c
         raise KeyError(name)
+
+    def with_parameters(self, overrides: Mapping[str, Mapping[str, Value]]) -> SystemDescription:
+        """This system with parameter ``overrides`` (component name → parameter name → value)
+        set over each component's own; components not named keep theirs."""
+        unknown = sorted(set(overrides) - {c.name for c in self.components})
+        if unknown:
+            raise ParameterError(f"unknown component(s) {', '.join(unknown)} (known: {', '.join(c.name for c in self.components)})")
+        comps = tuple(replace(c, parameters={**c.parameters, **overrides[c.name]}) if c.name in overrides else c
+                      for c in self.components)
+        return replace(self, components=comps)
 
 
 def _typed(value: Value) -> tuple[str, str]:

@@ -48,6 +48,8 @@ STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 ENGINES = ("fmpy", "python")
 #: Rows of a result kept in memory before they are written out (``out_file``).
 CHUNK_ROWS = 8192
+#: Steps between two checks of a run's wall-time limit (``SystemRunner.run(timeout=…)``).
+TIMEOUT_CHECK = 100
 
 
 @dataclass(frozen=True)
@@ -270,7 +272,8 @@ class SystemRunner:
         return _FmpyComponent(comp.name, md, unzip_dir, callbacks)
 
     def run(self, stop_time: float | None = None, record: Sequence[str] | None = None,
-            progress: bool | None = None, out_file: str | Path | None = None) -> np.ndarray:
+            progress: bool | None = None, out_file: str | Path | None = None,
+            timeout: float | None = None) -> np.ndarray:
         """Simulate from the system's start time to ``stop_time`` [s].
 
         Parameters
@@ -285,6 +288,9 @@ class SystemRunner:
             Stream the rows to this ``.npy`` file as the run goes (:data:`CHUNK_ROWS` at a
             time) instead of keeping them in memory; the result is then the file opened as a
             read-only memory map (``numpy.load(out_file, mmap_mode="r")`` reads it later).
+        timeout : float, optional
+            Wall-time limit of the stepping [s]: past it the run stops with
+            :class:`~marinefmu.errors.SystemError_` (checked every :data:`TIMEOUT_CHECK` steps).
 
         Returns
         -------
@@ -341,8 +347,12 @@ class SystemRunner:
                        desc=sysd.name, mininterval=0.5)
             spent = self.step_seconds = dict.fromkeys(instances, 0.0)
             clock = time.perf_counter
+            deadline = math.inf if timeout is None else clock() + timeout
             try:
                 for k in range(n_steps):
+                    if k % TIMEOUT_CHECK == 0 and clock() > deadline:
+                        raise SystemError_(f"{sysd.name}: wall-time limit of {timeout:g} s reached at t = {t0 + k * sysd.step:.6g} s "
+                                           f"of {stop:g} s")
                     t = t0 + k * sysd.step
                     due = [n for n, m in rates.items() if k % m == 0]
                     self._transfer(wires, due)

@@ -1,0 +1,117 @@
+"""One campaign run, as a Dask task in a worker process: the FMUs, the simulation, the metrics.
+
+The FMUs travel with the campaign (scattered once to every worker as bytes), so a worker needs
+marinefmu and its dependencies installed but no shared file system: each worker process writes
+them once to a temporary folder of its own (:func:`fmu_folder`). A run instantiates the
+scenario's FMUs in the worker process (:class:`~marinefmu.cosim.system.SystemRunner`),
+simulates, scores the estimators against the vessel's truth (:func:`marinefmu.scoring.score`)
+and returns a small record; the time series only when the campaign keeps them. Any error of a
+run (an FMU refusing a combination of values, a failed step, the wall-time limit) becomes a
+record with ``status = "failed"`` and the error, so the campaign goes on.
+"""
+from __future__ import annotations
+
+import atexit
+import hashlib
+import math
+import os
+import shutil
+import socket
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..cosim.ssp import SystemDescription
+from .spec import Run
+
+#: This process's FMU folders, by the hash of their contents.
+_FOLDERS: dict[str, Path] = {}
+
+
+@dataclass(frozen=True)
+class RunTask:
+    """What a worker needs for one run (everything but the FMUs).
+
+    Attributes
+    ----------
+    run : Run
+        The run's identity, values and parameter overrides.
+    system : SystemDescription
+        The scenario's system, before the overrides.
+    record : tuple of str or None
+        Variables to record (the scenario's ``[record]``); None = every output.
+    duration, settle, timeout : float
+        Simulated time, unscored settling time and wall-time limit [s].
+    engine, vessel : str
+        ``SystemRunner`` engine; VesselMotion component whose truth scores the others.
+    metrics : tuple of str or None
+        ``component.metric`` to keep; None = every one.
+    keep_series : bool
+        Return the recorded time series too.
+    """
+
+    run: Run
+    system: SystemDescription
+    record: tuple[str, ...] | None
+    duration: float
+    settle: float
+    timeout: float
+    engine: str
+    vessel: str
+    metrics: tuple[str, ...] | None
+    keep_series: bool
+
+
+def fmu_folder(fmus: dict[str, bytes]) -> Path:
+    """A folder of this process holding ``fmus`` (file name → content), written once per content."""
+    h = hashlib.sha1()
+    for name in sorted(fmus):
+        h.update(name.encode())
+        h.update(hashlib.sha1(fmus[name]).digest())
+    key = h.hexdigest()
+    if key not in _FOLDERS:
+        folder = Path(tempfile.mkdtemp(prefix="marinefmu_campaign_"))
+        atexit.register(shutil.rmtree, folder, ignore_errors=True)
+        for name, data in fmus.items():
+            (folder / name).write_bytes(data)
+        _FOLDERS[key] = folder
+    return _FOLDERS[key]
+
+
+def run_one(task: RunTask, fmus: dict[str, bytes]) -> dict[str, Any]:
+    """Simulate and score one run (module docstring); never raises for a failed run.
+
+    Returns
+    -------
+    dict
+        ``id``, ``values``, ``status`` ("ok" or "failed"), ``error``, ``metrics``
+        (``component.metric`` → value; NaN for a kept metric the run did not give),
+        ``run_s`` (wall time of the simulation) and ``wall_s`` (of the whole task) [s],
+        ``worker`` (host:pid), ``rss_mb`` (the worker's resident memory after the run), and
+        ``series`` (structured array) when the task keeps it.
+    """
+    from ..bench_system import rss_mb
+    from ..cosim.system import SystemRunner
+    from ..scoring import score
+
+    start = time.perf_counter()
+    out: dict[str, Any] = {"id": task.run.id, "values": task.run.values, "status": "ok", "error": "",
+                           "metrics": {}, "run_s": math.nan, "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    try:
+        system = task.system.with_parameters(task.run.overrides)
+        runner = SystemRunner(system, fmu_folder(fmus), engine=task.engine)
+        t0 = time.perf_counter()
+        result = runner.run(task.duration, record=task.record, progress=False, timeout=task.timeout)
+        out["run_s"] = time.perf_counter() - t0
+        scores = score(result, system, task.vessel, task.settle)
+        metrics = {f"{comp}.{name}": float(v) for comp, row in scores.items() for name, v in row.items()}
+        out["metrics"] = metrics if task.metrics is None else {m: metrics.get(m, math.nan) for m in task.metrics}
+        if task.keep_series:
+            out["series"] = result
+    except Exception as exc:  # noqa: BLE001 - a failed run is a record; the campaign goes on
+        out.update(status="failed", error=f"{type(exc).__name__}: {exc}")
+    out["wall_s"] = time.perf_counter() - start
+    out["rss_mb"] = rss_mb()
+    return out
