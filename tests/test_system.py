@@ -262,3 +262,21 @@ def test_two_builders_of_one_folder_take_turns(tmp_path):
     outs = [p.communicate(timeout=300) for p in procs]
     assert [p.returncode for p in procs] == [0, 0], [err[-2000:] for _, err in outs]
     assert sorted(out.strip() for out, _ in outs) == ["[False]", "[True]"]
+
+
+def test_runs_leave_sys_path_as_they_found_it(fmu_dir):
+    """pythonfmu puts each instance's resources folder on sys.path; a run takes its own temporary
+    folders off again, so a process running system after system (a campaign worker) does not
+    gain six entries a run (it did: 6 → 36 entries after five runs of the system scenario)."""
+    import sys
+
+    from marinefmu.cosim.system import SystemRunner
+    from marinefmu.scenarios import load_scenario
+
+    sc = load_scenario("system")
+    SystemRunner(sc.system, fmu_dir).run(0.05, record=sc.record, progress=False)   # first-run imports
+    before = list(sys.path)
+    for _ in range(2):
+        SystemRunner(sc.system, fmu_dir).run(0.05, record=sc.record, progress=False)
+    assert sys.path == before
+    assert not [k for k in sys.path_importer_cache if "marinefmu_" in k and k.startswith(("/tmp", "/var"))]

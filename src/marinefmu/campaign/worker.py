@@ -2,8 +2,8 @@
 
 The FMUs travel with the campaign (scattered once to every worker as bytes), so a worker needs
 marinefmu and its dependencies installed but no shared file system: each worker process writes
-them once to a temporary folder of its own (:func:`fmu_folder`). A run instantiates the
-scenario's FMUs in the worker process (:class:`~marinefmu.cosim.system.SystemRunner`),
+them once to a temporary folder of its own and extracts them there (:func:`fmu_folder`). A run
+instantiates the scenario's FMUs in the worker process (:class:`~marinefmu.cosim.system.SystemRunner`),
 simulates, scores the estimators against the vessel's truth (:func:`marinefmu.scoring.score`)
 and returns a small record; the time series only when the campaign keeps them. Any error of a
 run (an FMU refusing a combination of values, a failed step, the wall-time limit) becomes a
@@ -26,8 +26,8 @@ from typing import Any
 from ..cosim.ssp import SystemDescription
 from .spec import Run
 
-#: This process's FMU folders, by the hash of their contents.
-_FOLDERS: dict[str, Path] = {}
+#: This process's FMU folders and their extracted FMUs, by the hash of their contents.
+_FOLDERS: dict[str, tuple[Path, dict[Path, Path]]] = {}
 
 
 @dataclass(frozen=True)
@@ -64,8 +64,13 @@ class RunTask:
     keep_series: bool
 
 
-def fmu_folder(fmus: dict[str, bytes]) -> Path:
-    """A folder of this process holding ``fmus`` (file name → content), written once per content."""
+def fmu_folder(fmus: dict[str, bytes]) -> tuple[Path, dict[Path, Path]]:
+    """A folder of this process holding ``fmus`` (file name → content) and each FMU extracted
+    (FMU file → its folder, :class:`~marinefmu.cosim.system.SystemRunner`'s ``unpacked``),
+    written once per content: runs after the first neither unzip nor load new copies of the
+    FMUs' binaries."""
+    from fmpy import extract
+
     h = hashlib.sha1()
     for name in sorted(fmus):
         h.update(name.encode())
@@ -74,10 +79,25 @@ def fmu_folder(fmus: dict[str, bytes]) -> Path:
     if key not in _FOLDERS:
         folder = Path(tempfile.mkdtemp(prefix="marinefmu_campaign_"))
         atexit.register(shutil.rmtree, folder, ignore_errors=True)
-        for name, data in fmus.items():
-            (folder / name).write_bytes(data)
-        _FOLDERS[key] = folder
+        unpacked = {}
+        for i, (name, data) in enumerate(fmus.items()):
+            path = folder / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+            unpacked[path.resolve()] = Path(extract(str(path), unzipdir=str(folder / f"unpacked_{i}")))
+        _FOLDERS[key] = folder, unpacked
     return _FOLDERS[key]
+
+
+def prepare() -> int:
+    """Import what every run needs (scipy, filterpy, python-control, the estimators: seconds),
+    once per worker process before the first run; the process id."""
+    import marinefmu.cosim.estimator_io  # noqa: F401
+    import marinefmu.cosim.system  # noqa: F401
+    import marinefmu.estimators.heave  # noqa: F401
+    import marinefmu.scoring  # noqa: F401
+
+    return os.getpid()
 
 
 def run_one(task: RunTask, fmus: dict[str, bytes]) -> dict[str, Any]:
@@ -101,7 +121,8 @@ def run_one(task: RunTask, fmus: dict[str, bytes]) -> dict[str, Any]:
                            "metrics": {}, "run_s": math.nan, "worker": f"{socket.gethostname()}:{os.getpid()}"}
     try:
         system = task.system.with_parameters(task.run.overrides)
-        runner = SystemRunner(system, fmu_folder(fmus), engine=task.engine)
+        folder, unpacked = fmu_folder(fmus)
+        runner = SystemRunner(system, folder, engine=task.engine, unpacked=unpacked)
         t0 = time.perf_counter()
         result = runner.run(task.duration, record=task.record, progress=False, timeout=task.timeout)
         out["run_s"] = time.perf_counter() - t0

@@ -29,9 +29,10 @@ import itertools
 import logging
 import math
 import shutil
+import sys
 import tempfile
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from ctypes import byref
 from dataclasses import dataclass
 from pathlib import Path
@@ -204,6 +205,16 @@ class _Recorder:
             self.fh.close()
 
 
+def _forget_paths(root: str) -> None:
+    """Drop the ``sys.path`` entries (and their importer cache) under ``root``: pythonfmu's loader
+    puts each instance's resources folder on ``sys.path`` and never takes it off, so a process
+    running system after system (a campaign worker) gained six entries a run, each a folder
+    already deleted, and every later import searched them all."""
+    sys.path[:] = [p for p in sys.path if not p.startswith(root)]
+    for key in [k for k in sys.path_importer_cache if k.startswith(root)]:
+        del sys.path_importer_cache[key]
+
+
 class SystemRunner:
     """Run a :class:`~marinefmu.cosim.ssp.SystemDescription` with FMPy or in-process.
 
@@ -216,6 +227,10 @@ class SystemRunner:
     engine : {"fmpy", "python"}
         FMUs through FMI with FMPy, or their slave classes in this interpreter (module
         docstring).
+    unpacked : mapping of Path to Path, optional
+        FMU file → folder it is already extracted in (``fmpy.extract``), used as it is and
+        kept; other FMUs are extracted into a temporary folder for each run. A process that
+        runs many systems (a campaign worker) extracts each FMU once.
 
     Examples
     --------
@@ -224,7 +239,8 @@ class SystemRunner:
     >>> result["vessel.truth.cog.d"]                                # doctest: +SKIP
     """
 
-    def __init__(self, system: SystemDescription, base_dir: str | Path = ".", engine: str = "fmpy") -> None:
+    def __init__(self, system: SystemDescription, base_dir: str | Path = ".", engine: str = "fmpy",
+                 unpacked: Mapping[Path, Path] | None = None) -> None:
         if engine not in ENGINES:
             raise SystemError_(f"engine = {engine!r} is not allowed: must be one of {', '.join(map(repr, ENGINES))}")
         self.system = system
@@ -232,6 +248,8 @@ class SystemRunner:
         self.engine = engine
         self.messages: list[FmuMessage] = []
         self.descriptions = check_system(system, self.base_dir)
+        #: FMU file (resolved) → folder it is already extracted in: used as it is and kept.
+        self.unpacked = {Path(k).resolve(): Path(v) for k, v in (unpacked or {}).items()}
         #: Wall time [s] each component spent in its steps during the last run.
         self.step_seconds: dict[str, float] = {}
 
@@ -314,7 +332,7 @@ class SystemRunner:
         recorder = None
         t = t0
         try:
-            unzipped: dict[Path, Path] = {}
+            unzipped: dict[Path, Path] = dict(self.unpacked)
             for comp in sysd.components:
                 src = comp.path(self.base_dir).resolve()
                 if src not in unzipped:
@@ -379,6 +397,7 @@ class SystemRunner:
                 except Exception:  # noqa: BLE001 - freeing must go on for the others
                     log.exception("freeing %s failed", inst.name)
             shutil.rmtree(tmp, ignore_errors=True)
+            _forget_paths(str(tmp))
 
     @staticmethod
     def _record_fields(mds: dict[str, Any], record: Sequence[str] | None) -> dict[str, tuple[str, str, int]]:
