@@ -19,7 +19,7 @@ from typing import Any
 from ..errors import MarineFmuError
 from .spec import CampaignSpec
 from .table import append_log, read_log, write_table
-from .worker import RunTask, prepare, run_one
+from .worker import Job, prepare, run_one
 
 log = logging.getLogger("marinefmu.campaign")
 #: How long to wait for a scheduler given by address [s].
@@ -148,11 +148,11 @@ def run_campaign(spec: CampaignSpec, out: str | Path, fmu_dir: str | Path, sched
             client.run(prepare)   # every worker imports the estimators now, not in its first run
             startup = time.perf_counter() - t_start
             sc = spec.scenario
-            tasks = {r.id: RunTask(r, sc.system, sc.record, spec.duration, spec.settle, spec.timeout, spec.engine,
-                                   spec.vessel, spec.metrics, spec.keep_series) for r in todo}
+            job = client.scatter([Job(sc.system, sc.record, spec.duration, spec.settle, spec.timeout, spec.engine,
+                                      spec.vessel, spec.metrics, spec.keep_series)], broadcast=True)[0]
+            by_id = {r.id: r for r in todo}
             t0 = time.perf_counter()
-            futures = [client.submit(run_one, tasks[r.id], fmus, key=f"run-{r.id}", pure=False, retries=0)
-                       for r in todo]
+            futures = [client.submit(run_one, r, job, fmus, key=f"run-{r.id}", pure=False, retries=0) for r in todo]
             bar = tqdm(total=len(todo), unit="run", desc=spec.name, disable=not progress, smoothing=0.1)
             failed_now = 0
             try:
@@ -161,7 +161,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, fmu_dir: str | Path, sched
                     try:
                         rec = fut.result()
                     except Exception as exc:  # noqa: BLE001 - a worker died (KilledWorker) or the task broke
-                        rec = {"id": run_id, "values": tasks[run_id].run.values, "status": "failed", "metrics": {},
+                        rec = {"id": run_id, "values": by_id[run_id].values, "status": "failed", "metrics": {},
                                "error": f"{type(exc).__name__}: {exc}"}
                     fut.release()
                     if rec.get("series") is not None:
