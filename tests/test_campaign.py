@@ -194,3 +194,26 @@ def test_the_cli_refuses_a_bad_spec_and_a_bad_worker_count(spec_file, fmu_dir, c
     assert main(["campaign", str(spec_file), "--fmus", str(fmu_dir)]) == 2
     err = capsys.readouterr().err
     assert "grid.'vessel.sea.omega_min' = -0.6: refused" in err and "sea.omega_min" in err
+
+
+@pytest.mark.isolated(timeout=600)
+def test_the_cli_runs_a_campaign_and_draws_its_map_and_comparison(tmp_path, fmu_dir, capsys):
+    from marinefmu.cli import main
+
+    (tmp_path / "att_only.toml").write_text(SCENARIO)
+    spec = tmp_path / "maps.toml"
+    spec.write_text('[campaign]\nname = "maps"\nscenario = "att_only.toml"\nduration = 15.0\nsettle = 1.0\n'
+                    '[grid]\n"vessel.sea.hs" = [1.0, 3.0]\n"vessel.sea.tp" = [6.0, 10.0]\n'
+                    '[sets.imu.bow]\n"vessel.imu" = { x = 40.0, y = 0.0, z = -5.0 }\n'
+                    '[sets.imu.cog]\n"vessel.imu" = { x = 0.0, y = 0.0, z = 0.0 }\n')
+    out = tmp_path / "out"
+    assert main(["campaign", str(spec), "--workers", "2", "--out", str(out), "--fmus", str(fmu_dir), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    assert "8 run(s) now, 0 already in the table; 8 succeeded, 0 failed of 8" in printed
+    assert (out / "maps" / "att.png").stat().st_size > 10_000 and (out / "compare_imu.png").stat().st_size > 10_000
+    rows = read_table(out / "results.csv")
+    assert len(rows) == 8 and all(r["status"] == "ok" and r["att.roll_deg"] > 0 for r in rows)
+    assert (out / "spec.toml").read_text() == spec.read_text()
+    # rerun: nothing left to do, no cluster started
+    assert main(["campaign", str(spec), "--out", str(out), "--fmus", str(fmu_dir), "--no-progress", "--no-plots"]) == 0
+    assert "0 run(s) now, 8 already in the table" in capsys.readouterr().out

@@ -2,7 +2,9 @@
 
 - **Throughput**: the same 8 runs (the ``system`` scenario, :data:`RUN_S` simulated seconds
   each, Hs × Tp × seed) on a local cluster of 1 and of 2 workers, in runs per hour from the
-  first submission to the last result. Goal: 2 workers ≥ 1.8 × 1 worker.
+  first submission to the last result; each cluster size :data:`REPEATS` times, alternating,
+  and the best of each kept (this shared machine's speed varies by tens of percent from one
+  minute to the next). Goal: 2 workers ≥ 1.8 × 1 worker.
 - **Engine overhead per run** (scheduling, serialisation, result transfer, table writing): on
   the 1-worker cluster, the wall time between first submission and last result minus the time
   the worker spent inside the runs (each run's own ``wall_s``), per run; against the wall time
@@ -23,8 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-#: Simulated time of each throughput run [s].
+#: Simulated time of each throughput run [s], and how many times each cluster size runs them.
 RUN_S = 60.0
+REPEATS = 2
 #: Simulated time of each memory run [s], and how many of them.
 MEMORY_RUN_S = 5.0
 MEMORY_RUNS = 200
@@ -65,16 +68,21 @@ def campaign_bench(fmu_dir: Path, work: Path | None = None) -> dict:
     shutil.rmtree(work, ignore_errors=True)
     spec = parse_spec(_THROUGHPUT.format(duration=RUN_S), fmu_dir, "bench throughput")
     runs: dict[int, dict] = {}
-    for n in (1, 2):
-        out = work / f"throughput_{n}"
-        o = run_campaign(spec, out, fmu_dir, workers=n, progress=False)
-        recs = list(read_log(out).values())
-        runs[n] = {"workers": n, "runs": o.ran, "failed": o.failed, "wall_s": o.wall_s, "startup_s": o.startup_s,
-                   "runs_per_hour": o.ran / o.wall_s * 3600,
-                   "mean_run_s": float(np.mean([r["run_s"] for r in recs])),
-                   "mean_task_s": float(np.mean([r["wall_s"] for r in recs]))}
-        print(f"  campaign, {o.ran} runs of {RUN_S:g} s on {n} worker(s): {o.wall_s:.1f} s after {o.startup_s:.1f} s of start-up, "
-              f"{runs[n]['runs_per_hour']:.0f} runs/h ({o.failed} failed)")
+    for rep in range(REPEATS):
+        for n in (1, 2):
+            out = work / f"throughput_{n}_{rep}"
+            o = run_campaign(spec, out, fmu_dir, workers=n, progress=False)
+            recs = list(read_log(out).values())
+            this = {"workers": n, "runs": o.ran, "failed": o.failed, "wall_s": o.wall_s, "startup_s": o.startup_s,
+                    "runs_per_hour": o.ran / o.wall_s * 3600,
+                    "mean_run_s": float(np.mean([r["run_s"] for r in recs])),
+                    "mean_task_s": float(np.mean([r["wall_s"] for r in recs]))}
+            print(f"  campaign, {o.ran} runs of {RUN_S:g} s on {n} worker(s): {o.wall_s:.1f} s after {o.startup_s:.1f} s "
+                  f"of start-up, {this['runs_per_hour']:.0f} runs/h ({o.failed} failed)")
+            walls = runs.get(n, {}).get("all_wall_s", []) + [o.wall_s]
+            if n not in runs or o.wall_s < runs[n]["wall_s"]:
+                runs[n] = this
+            runs[n]["all_wall_s"] = walls
     one = runs[1]
     overhead = (one["wall_s"] - one["runs"] * one["mean_task_s"]) / one["runs"]
     ten_minutes = one["mean_run_s"] / RUN_S * 600.0
