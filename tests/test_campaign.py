@@ -130,7 +130,7 @@ def test_a_local_cluster_runs_the_grid_records_a_failure_and_resumes(spec_file, 
 
     spec = load_spec(spec_file, fmu_dir)
     out = tmp_path / "out"
-    first = run_campaign(spec, out, fmu_dir, workers=2, progress=False)
+    first = run_campaign(spec, out, workers=2, progress=False)
     assert (first.total, first.ran, first.ok, first.failed, first.skipped) == (8, 8, 6, 2, 0)
     rows = read_table(out / "results.csv")
     assert [r["id"] for r in rows] == [r.id for r in spec.runs()]   # every run, in the campaign's order
@@ -157,18 +157,18 @@ def test_a_local_cluster_runs_the_grid_records_a_failure_and_resumes(spec_file, 
     direct = score(result, system, "vessel", spec.settle)["att"]
     assert {m: rows[0][f"att.{m}"] for m in direct} == direct
 
-    again = run_campaign(spec, out, fmu_dir, workers=2, progress=False)          # resume: nothing to do
+    again = run_campaign(spec, out, workers=2, progress=False)          # resume: nothing to do
     assert (again.ran, again.skipped, again.ok, again.failed) == (0, 8, 6, 2)
     assert [json.loads(line) for line in (out / LOG_NAME).read_text().splitlines()] == records
 
     # a run cut off in the middle of writing its line (a crash, a Ctrl-C) is run again
     log_text = (out / LOG_NAME).read_text()
     (out / LOG_NAME).write_text(log_text[: log_text.rindex("\n", 0, -1) + 1] + log_text.splitlines()[-1][:40])
-    torn = run_campaign(spec, out, fmu_dir, workers=1, progress=False)
+    torn = run_campaign(spec, out, workers=1, progress=False)
     assert (torn.ran, torn.skipped, torn.ok + torn.failed) == (1, 7, 8)
     assert [r["id"] for r in read_table(out / "results.csv")] == [r.id for r in spec.runs()]
 
-    retried = run_campaign(spec, out, fmu_dir, workers=2, progress=False, retry_failed=True)
+    retried = run_campaign(spec, out, workers=2, progress=False, retry_failed=True)
     assert (retried.ran, retried.failed) == (2, 2)                   # the failing pair fails again
 
 
@@ -181,7 +181,7 @@ def test_an_unreachable_scheduler_fails_fast_naming_it(spec_file, tmp_path, fmu_
     spec = load_spec(spec_file, fmu_dir, check_values=False)
     t0 = time.perf_counter()
     with pytest.raises(CampaignError, match=r"--scheduler 'tcp://127.0.0.1:9': cannot reach a Dask scheduler"):
-        run_campaign(spec, tmp_path / "out", fmu_dir, scheduler="tcp://127.0.0.1:9", progress=False)
+        run_campaign(spec, tmp_path / "out", scheduler="tcp://127.0.0.1:9", progress=False)
     assert time.perf_counter() - t0 < 30.0
 
 
@@ -197,23 +197,55 @@ def test_the_cli_refuses_a_bad_spec_and_a_bad_worker_count(spec_file, fmu_dir, c
 
 
 @pytest.mark.isolated(timeout=600)
-def test_the_cli_runs_a_campaign_and_draws_its_map_and_comparison(tmp_path, fmu_dir, capsys):
+def test_the_cli_runs_a_campaign_of_an_ssp_package_and_draws_its_map_and_comparison(tmp_path, fmu_dir, capsys):
     from marinefmu.cli import main
+    from marinefmu.cosim.ssp import write_ssp
+    from marinefmu.scenarios import parse_scenario
 
-    (tmp_path / "att_only.toml").write_text(SCENARIO)
+    write_ssp(parse_scenario(SCENARIO).system, fmu_dir, tmp_path / "att_only.ssp")   # the system with its FMUs
     spec = tmp_path / "maps.toml"
-    spec.write_text('[campaign]\nname = "maps"\nscenario = "att_only.toml"\nduration = 15.0\nsettle = 1.0\n'
+    spec.write_text('[campaign]\nname = "maps"\nscenario = "att_only.ssp"\nduration = 15.0\nsettle = 1.0\n'
                     '[grid]\n"vessel.sea.hs" = [1.0, 3.0]\n"vessel.sea.tp" = [6.0, 10.0]\n'
                     '[sets.imu.bow]\n"vessel.imu" = { x = 40.0, y = 0.0, z = -5.0 }\n'
                     '[sets.imu.cog]\n"vessel.imu" = { x = 0.0, y = 0.0, z = 0.0 }\n')
     out = tmp_path / "out"
-    assert main(["campaign", str(spec), "--workers", "2", "--out", str(out), "--fmus", str(fmu_dir), "--no-progress"]) == 0
+    assert main(["campaign", str(spec), "--workers", "2", "--out", str(out), "--no-progress"]) == 0
     printed = capsys.readouterr().out
     assert "8 run(s) now, 0 already in the table; 8 succeeded, 0 failed of 8" in printed
     assert (out / "maps" / "att.png").stat().st_size > 10_000 and (out / "compare_imu.png").stat().st_size > 10_000
     rows = read_table(out / "results.csv")
     assert len(rows) == 8 and all(r["status"] == "ok" and r["att.roll_deg"] > 0 for r in rows)
     assert (out / "spec.toml").read_text() == spec.read_text()
-    # rerun: nothing left to do, no cluster started
-    assert main(["campaign", str(spec), "--out", str(out), "--fmus", str(fmu_dir), "--no-progress", "--no-plots"]) == 0
+    # rerun: nothing left to do, no cluster started (the package unpacked elsewhere: the same runs)
+    assert main(["campaign", str(spec), "--out", str(out), "--no-progress", "--no-plots"]) == 0
     assert "0 run(s) now, 8 already in the table" in capsys.readouterr().out
+
+
+@pytest.mark.isolated(timeout=600)
+def test_ctrl_c_leaves_a_consistent_table_and_a_rerun_goes_on(spec_file, tmp_path, fmu_dir):
+    """SIGINT to the whole process group, as Ctrl-C at a terminal sends it."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "marinefmu.cli", "campaign", str(spec_file), "--workers", "1", "--out", str(out),
+           "--fmus", str(fmu_dir), "--no-progress", "--no-plots"]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    log = out / LOG_NAME
+    deadline = time.monotonic() + 300
+    while not (log.exists() and log.read_text().count("\n") >= 1) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err[-3000:]
+    done = len(log.read_text().splitlines())
+    assert 1 <= done < 8
+    assert f"interrupted: {done} of 8 run(s) are in {out / 'results.csv'}; run the same command again" in err
+    assert "Traceback" not in err                                    # the workers left quietly
+    assert len(read_table(out / "results.csv")) == done              # the table holds exactly the finished runs
+    again = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 1                                     # the two failing runs of the grid
+    assert f"{8 - done} run(s) now, {done} already in the table; 6 succeeded, 2 failed of 8" in again.stdout

@@ -71,7 +71,7 @@ def campaign_bench(fmu_dir: Path, work: Path | None = None) -> dict:
     for rep in range(REPEATS):
         for n in (1, 2):
             out = work / f"throughput_{n}_{rep}"
-            o = run_campaign(spec, out, fmu_dir, workers=n, progress=False)
+            o = run_campaign(spec, out, workers=n, progress=False)
             recs = list(read_log(out).values())
             this = {"workers": n, "runs": o.ran, "failed": o.failed, "wall_s": o.wall_s, "startup_s": o.startup_s,
                     "runs_per_hour": o.ran / o.wall_s * 3600,
@@ -92,7 +92,7 @@ def campaign_bench(fmu_dir: Path, work: Path | None = None) -> dict:
 
     mem_spec = parse_spec(_MEMORY.format(duration=MEMORY_RUN_S, runs=MEMORY_RUNS), fmu_dir, "bench memory", check_values=False)
     out = work / "memory"
-    o = run_campaign(mem_spec, out, fmu_dir, workers=2, progress=False)
+    o = run_campaign(mem_spec, out, workers=2, progress=False)
     recs = list(read_log(out).values())   # in the order they finished
     workers = {}
     for w in sorted({r["worker"] for r in recs}):

@@ -240,7 +240,7 @@ def _cmd_campaign(args: argparse.Namespace) -> int:
           f"varying {', '.join(spec.axes)}; "
           + (f"scheduler {args.scheduler}" if args.scheduler else f"local cluster of {args.workers or 'one per core'} worker(s)"))
     try:
-        outcome = run_campaign(spec, out, fmu_dir, scheduler=args.scheduler, workers=args.workers,
+        outcome = run_campaign(spec, out, scheduler=args.scheduler, workers=args.workers,
                                retry_failed=args.retry_failed, progress=not args.no_progress)
     except KeyboardInterrupt:
         done = read_log(out)

@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import logging
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from ..cosim.ssp import SystemDescription
 from ..errors import MarineFmuError
 from .spec import CampaignSpec
 from .table import append_log, read_log, write_table
@@ -87,16 +88,22 @@ def connect(scheduler: str | None, workers: int | None):
     return Client(cluster), cluster
 
 
-def _fmus(spec: CampaignSpec, fmu_dir: Path) -> dict[str, bytes]:
-    """The scenario's FMU files, by the name its components give them."""
-    out = {}
-    for comp in spec.scenario.system.components:
-        src = comp.path(fmu_dir)
-        out[comp.source] = src.read_bytes()
-    return out
+def portable(spec: CampaignSpec) -> tuple[SystemDescription, dict[str, bytes]]:
+    """The scenario's system with each component naming its FMU by file name, and those files'
+    contents: what a worker on any machine needs (it writes them into a folder of its own)."""
+    files: dict[str, Path] = {}
+    comps = []
+    for c in spec.scenario.system.components:
+        src = c.path(spec.fmu_dir).resolve()
+        if files.setdefault(src.name, src) != src:
+            raise CampaignError(f"components.{c.name}: two different FMU files are named {src.name} "
+                                f"({files[src.name]} and {src}); rename one")
+        comps.append(replace(c, source=src.name))
+    system = replace(spec.scenario.system, components=tuple(comps))
+    return system, {name: path.read_bytes() for name, path in files.items()}
 
 
-def run_campaign(spec: CampaignSpec, out: str | Path, fmu_dir: str | Path, scheduler: str | None = None,
+def run_campaign(spec: CampaignSpec, out: str | Path, scheduler: str | None = None,
                  workers: int | None = None, retry_failed: bool = False, progress: bool = True) -> CampaignOutcome:
     """Run every run of ``spec`` not yet in ``out`` (module docstring).
 
@@ -106,8 +113,6 @@ def run_campaign(spec: CampaignSpec, out: str | Path, fmu_dir: str | Path, sched
         The validated campaign.
     out : str or Path
         Output folder: ``spec.toml`` (a copy), ``runs.jsonl``, ``results.csv``, ``series/``.
-    fmu_dir : str or Path
-        Folder of the built FMUs.
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:8786``); default a local cluster.
     workers : int, optional
@@ -144,11 +149,12 @@ def run_campaign(spec: CampaignSpec, out: str | Path, fmu_dir: str | Path, sched
             from dask.distributed import as_completed
 
             t_start = time.perf_counter()
-            fmus = client.scatter([_fmus(spec, Path(fmu_dir))], broadcast=True)[0]
-            client.run(prepare)   # every worker imports the estimators now, not in its first run
+            system, files = portable(spec)
+            fmus = client.scatter([files], broadcast=True)[0]
+            client.run(prepare, cluster is not None)   # every worker imports the estimators now, not in its first run
             startup = time.perf_counter() - t_start
             sc = spec.scenario
-            job = client.scatter([Job(sc.system, sc.record, spec.duration, spec.settle, spec.timeout, spec.engine,
+            job = client.scatter([Job(system, sc.record, spec.duration, spec.settle, spec.timeout, spec.engine,
                                       spec.vessel, spec.metrics, spec.keep_series)], broadcast=True)[0]
             by_id = {r.id: r for r in todo}
             t0 = time.perf_counter()

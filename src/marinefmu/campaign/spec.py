@@ -4,7 +4,7 @@ Format::
 
     [campaign]
     name = "scatter"            # default: the file's stem
-    scenario = "system"         # a built-in scenario, or a scenario TOML (relative to this file)
+    scenario = "system"         # a built-in scenario, a scenario TOML or an .ssp package (relative to this file)
     duration = 600.0            # simulated time per run [s], (0, 1e6]; default the scenario's
     settle = 60.0               # not scored after each estimator's valid goes true [s], [0, duration)
     timeout = 3600.0            # wall-time limit per run [s], (0, 1e6]; a run past it is recorded as failed
@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import ScenarioError, SystemError_
+from ..errors import ParameterError, ScenarioError, SystemError_
 from ..scenarios import Scenario, flatten, load_scenario
 
 _TOP = {"campaign", "grid", "sets"}
@@ -80,7 +80,9 @@ class Run:
 
 @dataclass(frozen=True)
 class CampaignSpec:
-    """A validated campaign (module docstring); :meth:`runs` lists its runs."""
+    """A validated campaign (module docstring); :meth:`runs` lists its runs. The scenario's
+    components name their FMUs by file name only, in ``fmu_dir`` (the FMU folder given, or
+    where an SSP package was unpacked), so run ids do not depend on where the files are."""
 
     name: str
     scenario: Scenario
@@ -93,6 +95,7 @@ class CampaignSpec:
     keep_series: bool
     grid: dict[str, tuple[Value, ...]]
     sets: dict[str, dict[str, dict[str, Value]]]
+    fmu_dir: Path = Path("fmus")
     source: str = ""
     text: str = field(default="", repr=False)
 
@@ -222,11 +225,12 @@ def parse_spec(text: str, fmu_dir: str | Path, source: str = "<string>", base: P
     if not isinstance(sc_name, str) or not sc_name:
         raise _fail(source, "campaign.scenario must name a built-in scenario or a scenario TOML file")
     sc_path = Path(sc_name)
-    if sc_path.suffix == ".toml" and not sc_path.is_absolute() and base is not None:
+    if sc_path.suffix in (".toml", ".ssp") and not sc_path.is_absolute() and base is not None:
         sc_path = base / sc_path
     try:
-        scenario = load_scenario(sc_path if sc_path.suffix == ".toml" else sc_name)
-    except ScenarioError as exc:
+        scenario, fmu_dir = (_ssp_scenario(sc_path) if sc_path.suffix == ".ssp" else
+                             (load_scenario(sc_path if sc_path.suffix == ".toml" else sc_name), Path(fmu_dir)))
+    except (ScenarioError, SystemError_, ParameterError) as exc:
         raise _fail(source, f"campaign.scenario: {exc}") from None
     name = camp.get("name", Path(source).stem)
     if not isinstance(name, str) or not name or any(c in name for c in "/\\"):
@@ -319,10 +323,29 @@ def parse_spec(text: str, fmu_dir: str | Path, source: str = "<string>", base: P
     if n_runs > MAX_RUNS:
         raise _fail(source, f"{n_runs} runs; at most {MAX_RUNS}")
     spec = CampaignSpec(name, scenario, duration, settle, timeout, engine, vessel, metrics, keep, grid, sets,
-                        source, text)
+                        Path(fmu_dir), source, text)
     if check_values:
-        check_values_alone(spec, fmu_dir)
+        check_values_alone(spec, spec.fmu_dir)
     return spec
+
+
+def _ssp_scenario(path: Path) -> tuple[Scenario, Path]:
+    """An SSP package as a scenario, unpacked into a folder of this process (removed at exit);
+    its components name their FMUs by file name in that folder."""
+    import atexit
+    import shutil
+    import tempfile
+    from dataclasses import replace
+
+    from ..cosim.ssp import read_ssp
+
+    into = Path(tempfile.mkdtemp(prefix="marinefmu_campaign_ssp_"))
+    atexit.register(shutil.rmtree, into, ignore_errors=True)
+    system = read_ssp(path, into)
+    comps = tuple(replace(c, source=Path(c.source).relative_to(into.resolve()).as_posix()) for c in system.components)
+    system = replace(system, components=comps)
+    return Scenario(system.name, f"SSP package {path}", system.stop_time - system.start_time, system.step, system,
+                    None, str(path)), into
 
 
 def check_values_alone(spec: CampaignSpec, fmu_dir: str | Path) -> None:

@@ -89,9 +89,17 @@ def fmu_folder(fmus: dict[str, bytes]) -> tuple[Path, dict[Path, Path]]:
     return _FOLDERS[key]
 
 
-def prepare() -> int:
+def prepare(local: bool = False) -> int:
     """Import what every run needs (scipy, filterpy, python-control, the estimators: seconds),
-    once per worker process before the first run; the process id."""
+    once per worker process before the first run; the process id. ``local``: the worker belongs
+    to the campaign's own local cluster, so a Ctrl-C at the terminal (which reaches every
+    process of the terminal's group) is left to the campaign, which cancels the runs and closes
+    the cluster, instead of breaking each worker with a traceback of its own."""
+    import signal
+    import threading
+
+    if local and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     import marinefmu.cosim.estimator_io  # noqa: F401
     import marinefmu.cosim.system  # noqa: F401
     import marinefmu.estimators.heave  # noqa: F401
