@@ -151,11 +151,9 @@ def run_campaign(spec: CampaignSpec, out: str | Path, scheduler: str | None = No
             t_start = time.perf_counter()
             system, files = portable(spec)
             fmus = client.scatter([files], broadcast=True)[0]
+            job = client.scatter([Job(system, spec)], broadcast=True)[0]
             client.run(prepare, cluster is not None)   # every worker imports the estimators now, not in its first run
             startup = time.perf_counter() - t_start
-            sc = spec.scenario
-            job = client.scatter([Job(system, sc.record, spec.duration, spec.settle, spec.timeout, spec.engine,
-                                      spec.vessel, spec.metrics, spec.keep_series)], broadcast=True)[0]
             by_id = {r.id: r for r in todo}
             t0 = time.perf_counter()
             futures = [client.submit(run_one, r, job, fmus, key=f"run-{r.id}", pure=False, retries=0) for r in todo]

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..cosim.ssp import SystemDescription
-from .spec import Run
+from .spec import CampaignSpec, Run
 
 #: This process's FMU folders and their extracted FMUs, by the hash of their contents.
 _FOLDERS: dict[str, tuple[Path, dict[Path, Path]]] = {}
@@ -40,28 +40,15 @@ class Job:
     Attributes
     ----------
     system : SystemDescription
-        The scenario's system, before the overrides.
-    record : tuple of str or None
-        Variables to record (the scenario's ``[record]``); None = every output.
-    duration, settle, timeout : float
-        Simulated time, unscored settling time and wall-time limit [s].
-    engine, vessel : str
-        ``SystemRunner`` engine; VesselMotion component whose truth scores the others.
-    metrics : tuple of str or None
-        ``component.metric`` to keep; None = every one.
-    keep_series : bool
-        Return the recorded time series too.
+        The scenario's system before a run's overrides, its components naming their FMUs by
+        file name (:func:`~.engine.portable`).
+    spec : CampaignSpec
+        The campaign: duration, settling time, time limit, engine, vessel, metrics, what to
+        record and whether to keep the series.
     """
 
     system: SystemDescription
-    record: tuple[str, ...] | None
-    duration: float
-    settle: float
-    timeout: float
-    engine: str
-    vessel: str
-    metrics: tuple[str, ...] | None
-    keep_series: bool
+    spec: CampaignSpec
 
 
 def fmu_folder(fmus: dict[str, bytes]) -> tuple[Path, dict[Path, Path]]:
@@ -131,14 +118,15 @@ def run_one(run: Run, task: Job, fmus: dict[str, bytes]) -> dict[str, Any]:
     try:
         system = task.system.with_parameters(run.overrides)
         folder, unpacked = fmu_folder(fmus)
-        runner = SystemRunner(system, folder, engine=task.engine, unpacked=unpacked)
+        spec = task.spec
+        runner = SystemRunner(system, folder, engine=spec.engine, unpacked=unpacked)
         t0 = time.perf_counter()
-        result = runner.run(task.duration, record=task.record, progress=False, timeout=task.timeout)
+        result = runner.run(spec.duration, record=spec.scenario.record, progress=False, timeout=spec.timeout)
         out["run_s"] = time.perf_counter() - t0
-        scores = score(result, system, task.vessel, task.settle)
+        scores = score(result, system, spec.vessel, spec.settle)
         metrics = {f"{comp}.{name}": float(v) for comp, row in scores.items() for name, v in row.items()}
-        out["metrics"] = metrics if task.metrics is None else {m: metrics.get(m, math.nan) for m in task.metrics}
-        if task.keep_series:
+        out["metrics"] = metrics if spec.metrics is None else {m: metrics.get(m, math.nan) for m in spec.metrics}
+        if spec.keep_series:
             out["series"] = result
     except Exception as exc:  # noqa: BLE001 - a failed run is a record; the campaign goes on
         out.update(status="failed", error=f"{type(exc).__name__}: {exc}")
