@@ -233,7 +233,10 @@ def test_ctrl_c_leaves_a_consistent_table_and_a_rerun_goes_on(spec_file, tmp_pat
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "marinefmu.cli", "campaign", str(spec_file), "--workers", "1", "--out", str(out),
            "--fmus", str(fmu_dir), "--no-progress", "--no-plots"]
-    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # SIGINT back to its default in the child: a shell's background job (CI's, say) starts with it
+    # ignored, and Python then installs no KeyboardInterrupt handler
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     log = out / LOG_NAME
     deadline = time.monotonic() + 300
     while not (log.exists() and log.read_text().count("\n") >= 1) and time.monotonic() < deadline:
