@@ -228,7 +228,7 @@ def _cmd_example(args: argparse.Namespace) -> int:
 def _cmd_campaign(args: argparse.Namespace) -> int:
     from .campaign import load_spec, run_campaign
     from .campaign.plots import plot_campaign
-    from .campaign.table import columns, read_log, read_table
+    from .campaign.table import read_log, read_table
 
     if args.workers is not None and args.workers < 1:
         raise MarineFmuError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
@@ -251,13 +251,12 @@ def _cmd_campaign(args: argparse.Namespace) -> int:
           f"{outcome.failed} failed of {outcome.total}"
           + (f"; {outcome.wall_s:.1f} s, {outcome.ran / outcome.wall_s * 3600:.0f} runs/h" if outcome.ran else ""))
     print(f"  table {outcome.table}")
-    for rec in (r for r in read_log(out).values() if r["status"] != "ok" and r["id"] in {x.id for x in runs}):
-        print(f"  failed {rec['id']} {rec['values']}: {rec['error'][:300]}")
+    rows = read_table(outcome.table)   # the campaign's runs only, whatever else the folder's log holds
+    for row in rows:
+        if row["status"] != "ok":
+            print(f"  failed {row['id']} {({a: row[a] for a in spec.axes})}: {row['error'][:300]}")
     if not args.no_plots:
-        rows = read_table(outcome.table)
-        metric_cols = [c for c in columns(spec.axes, read_log(out).values(), spec.metrics)
-                       if "." in c and c not in spec.axes]
-        for path in plot_campaign(spec, rows, metric_cols, out):
+        for path in plot_campaign(spec, rows, out):
             print(f"  plot {path}")
     return 0 if outcome.failed == 0 else 1
 

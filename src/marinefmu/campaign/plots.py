@@ -50,13 +50,16 @@ def _mean(values: list[float]) -> float:
     return sum(vals) / len(vals) if vals else math.nan
 
 
-def plot_campaign(spec: CampaignSpec, rows: list[dict[str, Any]], metric_columns: list[str], out: str | Path) -> list[Path]:
-    """Write the campaign's plots (module docstring) from its table rows; their paths."""
+def plot_campaign(spec: CampaignSpec, rows: list[dict[str, Any]], out: str | Path) -> list[Path]:
+    """Write the campaign's plots (module docstring) from its table rows (``table.read_table``);
+    their paths."""
     import numpy as np
 
     plt = _pyplot()
     out = Path(out)
     ok = [r for r in rows if r["status"] == "ok"]
+    # the metrics are the table's component.metric columns (the grid keys have dots too)
+    metric_columns = [c for c in (rows[0] if rows else {}) if "." in c and c not in spec.axes]
     # a metric no run gave (the heave observer not yet valid in a short run, say) has nothing to draw
     by_comp = _plotted([c for c in metric_columns if any(math.isfinite(r.get(c, math.nan)) for r in ok)])
     written: list[Path] = []

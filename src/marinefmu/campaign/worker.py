@@ -12,6 +12,7 @@ record with ``status = "failed"`` and the error, so the campaign goes on.
 from __future__ import annotations
 
 import atexit
+import functools
 import hashlib
 import math
 import os
@@ -19,6 +20,7 @@ import shutil
 import socket
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -141,11 +143,19 @@ def _give_back_freed_memory() -> None:
     elsewhere). Without it a worker's resident set crept up 80-150 kB a run after its warm-up,
     pages freed by one run but kept by the allocator in the task thread's arena (measured by
     ``marinefmu bench``, part ``campaign``)."""
+    trim = _malloc_trim()
+    if trim is not None:
+        trim(0)
+
+
+@functools.cache
+def _malloc_trim() -> Callable[[int], int] | None:
+    """glibc's ``malloc_trim``, looked up once per process (``find_library`` runs ``ldconfig``);
+    None where there is none (macOS, Windows, musl)."""
     import ctypes
     import ctypes.util
 
-    name = ctypes.util.find_library("c")
     try:
-        ctypes.CDLL(name).malloc_trim(0)
-    except (OSError, AttributeError, TypeError):   # not glibc (macOS, Windows, musl)
-        pass
+        return ctypes.CDLL(ctypes.util.find_library("c")).malloc_trim
+    except (OSError, AttributeError, TypeError):
+        return None

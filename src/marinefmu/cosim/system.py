@@ -28,6 +28,7 @@ import importlib.util
 import itertools
 import logging
 import math
+import os
 import shutil
 import sys
 import tempfile
@@ -210,8 +211,9 @@ def _forget_paths(root: str) -> None:
     puts each instance's resources folder on ``sys.path`` and never takes it off, so a process
     running system after system (a campaign worker) gained six entries a run, each a folder
     already deleted, and every later import searched them all."""
-    sys.path[:] = [p for p in sys.path if not p.startswith(root)]
-    for key in [k for k in sys.path_importer_cache if k.startswith(root)]:
+    inside = root.rstrip(os.sep) + os.sep
+    sys.path[:] = [p for p in sys.path if not p.startswith(inside)]
+    for key in [k for k in sys.path_importer_cache if k.startswith(inside)]:
         del sys.path_importer_cache[key]
 
 
