@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SystemError_
+from .exchange import Exchange, ExchangeError, Port, fmpy_channel, slave_channel
 from .ssp import SystemDescription
 from .system_check import check_system, lookup
 
@@ -83,6 +84,10 @@ class _FmpyComponent:
     def accessor(self, op: str, kind: str) -> Callable:
         """``getReal``/``setBoolean``/… of the FMU for a variable type."""
         return getattr(self.fmu, f"{op}{_fmi_type(kind)}")
+
+    def channel(self, op: str, kind: str, vrs: Sequence[int]):
+        """Buffer and call of the run's exchange (:func:`~.exchange.fmpy_channel`)."""
+        return fmpy_channel(self.fmu, op, kind, vrs)
 
     def setup(self, t0: float) -> None:
         self.fmu.setupExperiment(startTime=t0)
@@ -132,6 +137,10 @@ class _PythonComponent:
     def accessor(self, op: str, kind: str) -> Callable:
         """``get_real``/``set_boolean``/… of the slave for a variable type."""
         return getattr(self.slave, f"{op}_{_fmi_type(kind).lower()}")
+
+    def channel(self, op: str, kind: str, vrs: Sequence[int]):
+        """Buffer and call of the run's exchange (:func:`~.exchange.slave_channel`)."""
+        return slave_channel(self.slave, op, kind, vrs)
 
     def setup(self, t0: float) -> None:
         self.slave.setup_experiment(t0, None, None)
@@ -345,7 +354,6 @@ class SystemRunner:
                     v = lookup(inst.md, comp.name, name)   # type-checked by check_system
                     cast = {"Real": float, "Integer": int, "Boolean": bool}.get(_fmi_type(v.type), str)
                     inst.accessor("set", v.type)([v.valueReference], [cast(value)])
-            wires = self._wires(instances)
             for name, inst in instances.items():
                 logged = len(self.messages)
                 try:
@@ -359,10 +367,14 @@ class SystemRunner:
                     raise self._fail(name, "initialisation", t0, RuntimeError(refused[0].text))
             dtype = np.dtype([("time", "f8")] + [(f, "?" if k == "Boolean" else "f8") for f, (_, k, _) in fields.items()])
             recorder = _Recorder(dtype, n_steps + 1, out_file)
-            getters = self._getters(instances, fields, recorder)
+            exchange = Exchange(lambda comp, *how: instances[comp].channel(*how), self._wires(),
+                                [Port(comp, _fmi_type(kind), vr) for comp, kind, vr in fields.values()])
             rates = {c.name: c.rate for c in sysd.components}
-            self._transfer(wires, set(instances))
-            self._sample(recorder.row(), t0, getters)
+
+            def due_at(k: int) -> list[str]:
+                return [n for n, m in rates.items() if k % m == 0]
+
+            self._exchange(exchange, recorder.row(), t0, due_at(0))
             bar = tqdm(total=n_steps, unit="step", disable=not (progress if progress is not None else n_steps > 2000),
                        desc=sysd.name, mininterval=0.5)
             spent = self.step_seconds = dict.fromkeys(instances, 0.0)
@@ -374,16 +386,17 @@ class SystemRunner:
                         raise SystemError_(f"{sysd.name}: wall-time limit of {timeout:g} s reached at t = {t0 + k * sysd.step:.6g} s "
                                            f"of {stop:g} s")
                     t = t0 + k * sysd.step
-                    due = [n for n, m in rates.items() if k % m == 0]
-                    self._transfer(wires, due)
-                    for name in due:
+                    for name in due_at(k):
                         start = clock()
                         try:
                             instances[name].do_step(t, rates[name] * sysd.step)
                         except Exception as exc:
                             raise self._fail(name, "doStep", t, exc) from None
                         spent[name] += clock() - start
-                    self._sample(recorder.row(), t0 + (k + 1) * sysd.step, getters)
+                    # the inputs of the next step are set now: nothing changes the outputs
+                    # between this step's end and the next one's start
+                    self._exchange(exchange, recorder.row(), t0 + (k + 1) * sysd.step,
+                                   due_at(k + 1) if k + 1 < n_steps else ())
                     bar.update(1)
             finally:
                 bar.close()
@@ -420,58 +433,25 @@ class SystemRunner:
             fields[full] = (comp, v.type, v.valueReference)
         return fields
 
-    @staticmethod
-    def _getters(instances, fields, recorder: _Recorder) -> list:
-        """(getter, value references, columns) per (component, type) of the recorded fields."""
-        groups: dict[tuple[str, str], tuple[list[int], list[int]]] = {}
-        for f, (comp, kind, vr) in fields.items():
-            vrs, cols = groups.setdefault((comp, kind), ([], []))
-            vrs.append(vr)
-            cols.append(recorder.column(f))
-        return [(instances[comp].accessor("get", kind), vrs, np.array(cols)) for (comp, kind), (vrs, cols) in groups.items()]
-
-    @staticmethod
-    def _sample(row: np.ndarray, t: float, getters) -> None:
-        row[0] = t
-        for get, vrs, cols in getters:
-            row[cols] = get(vrs)
-
-    def _wires(self, instances: dict[str, Any]) -> list:
-        """The connections (checked by check_system) batched for speed: per destination
-        component, one get per (source component, type) and one set per type, as
-        (destination, [(getter, source vrs, slice)], [(setter, destination vrs, slice)], n)."""
-        by_end: dict[str, list] = {}
+    def _wires(self) -> list[tuple[Port, Port]]:
+        """The connections (checked by check_system) as (source, destination) ports."""
+        out = []
         for con in self.system.connections:
-            a = lookup(instances[con.start].md, con.start, con.start_var)
-            b = lookup(instances[con.end].md, con.end, con.end_var)
-            by_end.setdefault(con.end, []).append((con.start, _fmi_type(a.type), a.valueReference, b.valueReference))
-        wires = []
-        for end, items in by_end.items():
-            items.sort(key=lambda it: (it[0], it[1]))   # contiguous per source and type
-            gets, sets, pos = [], {}, 0
-            for (start, kind), group in itertools.groupby(items, key=lambda it: (it[0], it[1])):
-                group = list(group)
-                gets.append((instances[start].accessor("get", kind), [g[2] for g in group], slice(pos, pos + len(group))))
-                sets.setdefault(kind, []).extend((pos + i, g[3]) for i, g in enumerate(group))
-                pos += len(group)
-            setters = [(instances[end].accessor("set", kind), [vr for _, vr in pairs], [i for i, _ in pairs])
-                       for kind, pairs in sets.items()]
-            wires.append((end, gets, setters, pos))
-        return wires
+            a = lookup(self.descriptions[con.start], con.start, con.start_var)
+            b = lookup(self.descriptions[con.end], con.end, con.end_var)
+            out.append((Port(con.start, _fmi_type(a.type), a.valueReference),
+                        Port(con.end, _fmi_type(b.type), b.valueReference)))
+        return out
 
-    @staticmethod
-    def _transfer(wires, due) -> None:
-        # read every due input's source first, then set: all inputs see the outputs held at t
-        staged = []
-        for end, gets, setters, n in wires:
-            if end in due:
-                values: list = [None] * n
-                for get, vrs, where in gets:
-                    values[where] = get(vrs)
-                staged.append((setters, values))
-        for setters, values in staged:
-            for set_, vrs, idx in setters:
-                set_(vrs, [values[i] for i in idx])
+    def _exchange(self, exchange: Exchange, row: np.ndarray, t: float, due: Sequence[str]) -> None:
+        """Read the outputs held at ``t`` [s], record them in ``row`` and set the inputs of
+        the components ``due`` to step from ``t`` (:mod:`~.exchange`)."""
+        try:
+            exchange.read()
+            exchange.record(row, t)
+            exchange.write(due)
+        except ExchangeError as exc:
+            raise self._fail(exc.component or "?", "exchange", t, exc) from None
 
 
 def save_csv(result: np.ndarray, path: str | Path) -> Path:
