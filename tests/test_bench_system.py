@@ -4,6 +4,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from marinefmu.bench_system import peak_rss_mb
 
@@ -18,3 +19,30 @@ def test_a_worker_reports_its_own_peak_not_its_parents():
     child = float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout)
     assert 1.0 < child < 150.0, child                      # a bare interpreter and this module: ~20-80 MB
     assert held[-1] == 1.0
+
+
+@pytest.mark.fmu
+def test_idle_fmus_have_the_variables_of_the_real_ones_and_do_nothing(fmu_dir, tmp_path):
+    """The master's floor (bench_system.master_floor) runs the system scenario on FMUs with the
+    same variables whose doStep does nothing: they must load where the real ones do, be wired
+    the same way, and hold their start values."""
+    import zipfile
+
+    from fmpy import read_model_description
+
+    from marinefmu.bench_system import idle_fmus
+    from marinefmu.cosim.ssp import Component, Connection, SystemDescription
+    from marinefmu.cosim.system import SystemRunner
+
+    idle = idle_fmus(fmu_dir, tmp_path / "idle", ("VesselMotion", "AttitudeEstimator"))
+    for model in ("VesselMotion", "AttitudeEstimator"):
+        real, fake = (read_model_description(str(d / f"{model}.fmu")) for d in (fmu_dir, idle))
+        assert [(v.name, v.type, v.causality, v.variability, v.start) for v in fake.modelVariables] == \
+               [(v.name, v.type, v.causality, v.variability, v.start) for v in real.modelVariables]
+        assert zipfile.ZipFile(idle / f"{model}.fmu").namelist()     # a real FMU file
+    sysd = SystemDescription("idle", (Component("vessel", "VesselMotion.fmu", {"sea.hs": 3.0}),
+                                      Component("att", "AttitudeEstimator.fmu")),
+                             (Connection.parse("vessel.imu.gyro.x", "att.gyro.x"),), 0.01, 0.5)
+    r = SystemRunner(sysd, idle).run(record=["vessel.imu.gyro.x", "att.roll", "att.valid"], progress=False)
+    assert r.size == 51
+    assert np.all(r["vessel.imu.gyro.x"] == 0.0) and np.all(r["att.roll"] == 0.0) and not r["att.valid"].any()

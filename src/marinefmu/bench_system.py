@@ -126,6 +126,78 @@ def system_accuracy(fmu_dir: Path, work: Path, duration: float = 600.0) -> dict:
     return seas
 
 
+_IDLE_SCRIPT = """\
+from pythonfmu import Fmi2Slave, Fmi2Causality, Fmi2Variability, Real, Integer, Boolean, String
+
+TYPES = {{"Real": (Real, float), "Integer": (Integer, int), "Boolean": (Boolean, lambda s: s in ("true", "1")),
+          "String": (String, str)}}
+VARIABLES = {variables!r}
+
+
+class {cls}(Fmi2Slave):
+    \"\"\"The variables of {model}, and a doStep that does nothing (marinefmu.bench_system).\"\"\"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.values = {{}}
+        for name, causality, variability, kind, start in VARIABLES:
+            fmi_type, cast = TYPES[kind]
+            self.values[name] = cast(start) if start is not None else cast("0") if kind != "Boolean" else False
+            setter = None
+            if causality in ("input", "parameter"):
+                setter = lambda x, name=name: self.values.__setitem__(name, x)
+            self.register_variable(fmi_type(name, causality=getattr(Fmi2Causality, causality),
+                                            variability=getattr(Fmi2Variability, variability),
+                                            getter=lambda name=name: self.values[name], setter=setter))
+
+    def do_step(self, current_time, step_size):
+        return True
+"""
+
+
+def idle_fmus(fmu_dir: Path, dest: Path, models: tuple[str, ...]) -> Path:
+    """FMUs with the variables of ``fmu_dir/<model>.fmu`` (names, types, causalities, start
+    values) whose ``doStep`` does nothing, written as ``dest/<model>.fmu``: the ``system``
+    scenario run on them measures what the master, FMPy and pythonfmu cost by themselves."""
+    import shutil
+    import tempfile
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    from pythonfmu.builder import FmuBuilder
+
+    dest.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        for model in models:
+            md = ET.fromstring(zipfile.ZipFile(fmu_dir / f"{model}.fmu").read("modelDescription.xml"))
+            variables = []
+            for sv in md.find("ModelVariables"):
+                kind = sv[0]
+                variables.append((sv.get("name"), sv.get("causality", "local"), sv.get("variability", "continuous"),
+                                  kind.tag, kind.get("start")))
+            cls = f"Idle{model}"
+            script = Path(tmp) / f"{cls}.py"
+            script.write_text(_IDLE_SCRIPT.format(variables=variables, cls=cls, model=model))
+            built = Path(FmuBuilder.build_FMU(script, dest=tmp))
+            shutil.move(built, dest / f"{model}.fmu")
+    return dest
+
+
+def master_floor(fmu_dir: Path, work: Path, duration: float = 600.0) -> dict:
+    """The ``system`` scenario under the FMPy runner with :func:`idle_fmus`: the wall time of a
+    base step when the components compute nothing (the master's exchange and recording, FMPy's
+    and pythonfmu's calls), the real-time factor no Python estimator set can pass."""
+    models = tuple(sorted({Path(c.source).stem for c in _system(None, None).system.components}))
+    idle = idle_fmus(fmu_dir, work / "idle_fmus", models)
+    r = run_isolated("fmpy", idle, duration, work / "idle_run", scored=False)
+    r.pop("scores", None)
+    (work / "idle_run" / "results.npy").unlink(missing_ok=True)
+    r["base_step_us"] = 1e6 * r["wall_s"] / round(duration / _system(None, None).system.step)
+    print(f"system speed, FMUs that do nothing (the master and FMI alone): {duration:g} s in {r['wall_s']:.2f} s, "
+          f"real-time factor {r['rtf']:.0f}, {r['base_step_us']:.0f} µs per base step", flush=True)
+    return r
+
+
 def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_duration: float = 3 * 3600.0) -> dict:
     """The bench part ``system``: accuracy per sea (:func:`system_accuracy`), speed of the three
     engines on the default sea (``duration`` s each) with the FMI / in-process ratio, and peak
@@ -138,6 +210,7 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
         print(f"system speed, {engine:8s}: {duration:g} s in {r['wall_s']:.1f} s, real-time factor {r['rtf']:.1f}, "
               f"peak memory {r['peak_rss_mb']:.0f} MB" + ("" if not r.get("step_us") else "; per base step in doStep: "
               + ", ".join(f"{k} {v:.0f} µs" for k, v in r["step_us"].items())), flush=True)
+    result["speed"]["idle_fmus"] = master_floor(fmu_dir, work, duration)
     speed = result["speed"]
     result["fmi_over_in_process"] = speed["python"]["rtf"] / speed["fmpy"]["rtf"]
     print(f"FMI / in-process time ratio (FMPy runner / same code without FMI): {result['fmi_over_in_process']:.2f} "
