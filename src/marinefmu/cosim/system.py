@@ -6,6 +6,8 @@ receives its inputs from the outputs all components held at t, then all of them 
 (Jacobi coupling, as OSP libcosim's fixed-step algorithm does). Chosen variables are recorded
 at every base step into a structured numpy array whose fields are ``component.variable``, in
 memory or streamed to a ``.npy`` file in chunks (``out_file``) for long runs.
+After each base step every wired or recorded output is read once, and the row and the next
+step's inputs are taken from that read (:mod:`~.exchange`).
 
 Two engines run the same system the same way:
 
