@@ -14,7 +14,7 @@ Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_acc
 marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
 (``orcaflex``), the GNSS dropout coast of paper 001 over 40 dropouts (``dropout``,
 :func:`marinefmu.examples.paper001.dropouts`), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
-seas, speed under FMPy, in-process and libcosim, memory of a 3-hour run), the heave
+seas, speed under FMPy, in-process and libcosim and on do-nothing FMUs (the master's floor), memory of a 3-hour run), the heave
 compensation's design loop and four-way comparison (``ahc``, :mod:`marinefmu.bench_ahc`), and
 the memory of
 every FMU over 10⁶ steps and over 1,000 instantiate/free cycles (:mod:`marinefmu.bench_memory`,
@@ -289,7 +289,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     what they measure; return the whole file's data.
 
     ``speed`` takes a few minutes, ``heave`` about twenty (seven seas with their causal bounds, the ``band_min`` and ``window_max`` studies), ``peer`` about one, ``orcaflex`` a
-    few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 40 GNSS dropouts of 30 s and 4 of 5 min) about five, ``system`` (three seas, three engines and a 3-hour run) about an hour,
+    few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 40 GNSS dropouts of 30 s and 4 of 5 min) about five, ``system`` (three seas, three engines, do-nothing FMUs and a 3-hour run) about half an hour,
     ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
     2-core machine."""
     from .cosim.build import build_all, repo_root

@@ -1,4 +1,5 @@
-"""The whole system in the bench (issue 7): accuracy in three seas, speed under three engines,
+"""The whole system in the bench (issue 7): accuracy in three seas, speed under three engines
+(and the master alone, on do-nothing FMUs: :func:`master_floor`),
 and memory over three hours.
 
 Every measurement runs in a fresh process (as :mod:`marinefmu.bench_memory` does: clean
