@@ -188,12 +188,13 @@ def master_floor(fmu_dir: Path, work: Path, duration: float = 600.0) -> dict:
     """The ``system`` scenario under the FMPy runner with :func:`idle_fmus`: the wall time of a
     base step when the components compute nothing (the master's exchange and recording, FMPy's
     and pythonfmu's calls), the real-time factor no Python estimator set can pass."""
-    models = tuple(sorted({Path(c.source).stem for c in _system(None, None).system.components}))
+    system = _system(None, None).system
+    models = tuple(sorted({Path(c.source).stem for c in system.components}))
     idle = idle_fmus(fmu_dir, work / "idle_fmus", models)
     r = run_isolated("fmpy", idle, duration, work / "idle_run", scored=False)
     r.pop("scores", None)
     (work / "idle_run" / "results.npy").unlink(missing_ok=True)
-    r["base_step_us"] = 1e6 * r["wall_s"] / round(duration / _system(None, None).system.step)
+    r["base_step_us"] = 1e6 * r["wall_s"] / round(duration / system.step)
     print(f"system speed, FMUs that do nothing (the master and FMI alone): {duration:g} s in {r['wall_s']:.2f} s, "
           f"real-time factor {r['rtf']:.0f}, {r['base_step_us']:.0f} µs per base step", flush=True)
     return r

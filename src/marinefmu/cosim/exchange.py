@@ -126,11 +126,11 @@ class Exchange:
             slots.setdefault(port.vr, len(slots))
         self.reads: list[Callable[[], None]] = []
         buffers: dict[tuple[str, str], np.ndarray] = {}
-        self.failures: list[str] = []     # component of each read, for error messages
+        self.read_components: list[str] = []     # the component of each read, for error messages
         for (comp, kind), slots in needed.items():
             buffers[comp, kind], call = channel(comp, "get", kind, list(slots))
             self.reads.append(call)
-            self.failures.append(comp)
+            self.read_components.append(comp)
         # recording: per read buffer, positions in it → columns of the row
         rec: dict[tuple[str, str], tuple[list[int], list[int]]] = {}
         for col, port in enumerate(recorded, start=1):
@@ -161,7 +161,7 @@ class Exchange:
             try:
                 call()
             except ExchangeError as exc:
-                exc.component = self.failures[i]
+                exc.component = self.read_components[i]
                 raise
 
     def record(self, row: np.ndarray, t: float) -> None:
