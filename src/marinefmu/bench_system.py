@@ -162,20 +162,15 @@ def idle_fmus(fmu_dir: Path, dest: Path, models: tuple[str, ...]) -> Path:
     scenario run on them measures what the master, FMPy and pythonfmu cost by themselves."""
     import shutil
     import tempfile
-    import xml.etree.ElementTree as ET
-    import zipfile
 
+    from fmpy import read_model_description
     from pythonfmu.builder import FmuBuilder
 
     dest.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         for model in models:
-            md = ET.fromstring(zipfile.ZipFile(fmu_dir / f"{model}.fmu").read("modelDescription.xml"))
-            variables = []
-            for sv in md.find("ModelVariables"):
-                kind = sv[0]
-                variables.append((sv.get("name"), sv.get("causality", "local"), sv.get("variability", "continuous"),
-                                  kind.tag, kind.get("start")))
+            md = read_model_description(str(fmu_dir / f"{model}.fmu"))
+            variables = [(v.name, v.causality, v.variability, v.type, v.start) for v in md.modelVariables]
             cls = f"Idle{model}"
             script = Path(tmp) / f"{cls}.py"
             script.write_text(_IDLE_SCRIPT.format(variables=variables, cls=cls, model=model))

@@ -35,6 +35,7 @@ CTYPES = {"Real": ctypes.c_double, "Integer": ctypes.c_int, "Boolean": ctypes.c_
 #: Python conversion of a value handed to a slave in-process, per FMI type (pythonfmu's C++
 #: side passes these types).
 PY_TYPES: dict[str, Callable] = {"Real": float, "Integer": int, "Boolean": bool}
+#: FMI 2.0 status names by value (fmi2OK = 0 … fmi2Pending = 5).
 STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 
 

@@ -44,12 +44,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import SystemError_
-from .exchange import Exchange, ExchangeError, Port, fmpy_channel, slave_channel
+from .exchange import PY_TYPES, STATUS, Exchange, ExchangeError, Port, fmpy_channel, slave_channel
 from .ssp import SystemDescription
 from .system_check import check_system, lookup
 
 log = logging.getLogger("marinefmu.fmu")
-STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 ENGINES = ("fmpy", "python")
 #: Rows of a result kept in memory before they are written out (``out_file``).
 CHUNK_ROWS = 8192
@@ -354,7 +353,7 @@ class SystemRunner:
                 inst.setup(t0)
                 for name, value in comp.parameters.items():
                     v = lookup(inst.md, comp.name, name)   # type-checked by check_system
-                    cast = {"Real": float, "Integer": int, "Boolean": bool}.get(_fmi_type(v.type), str)
+                    cast = PY_TYPES.get(_fmi_type(v.type), str)
                     inst.accessor("set", v.type)([v.valueReference], [cast(value)])
             for name, inst in instances.items():
                 logged = len(self.messages)
