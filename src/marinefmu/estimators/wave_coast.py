@@ -120,6 +120,8 @@ class WaveCoast:
         self.block = 1                      # accelerometer samples per observer step
         self.k = 0                          # accelerometer samples seen (time = k·dt)
         self.acc_sum = np.zeros(3)          # a_n summed over the current block
+        self.step_sum = np.zeros(3)         # step means of a_n (trapezoid) summed over the block
+        self.last: np.ndarray | None = None  # previous a_n sample
         self.in_block = 0
         self.bands: list[AidedBand] = []    # per axis, from the first sample on
         self.k_band = 0                     # sample count at the end of the last block
@@ -133,15 +135,21 @@ class WaveCoast:
         if self.dt is None:
             self._start(dt)
         self.k += 1
+        acc_n = np.asarray(acc_n, dtype=float)
         self.acc_sum += acc_n
+        # the band filters measure the mean of a_n over their step: the samples are points, so
+        # each sample's step contributes the mean of it and the one before (trapezoid)
+        self.step_sum += acc_n if self.last is None else 0.5 * (self.last + acc_n)
+        self.last = acc_n.copy()
         self.in_block += 1
         if self.in_block < self.block:
             return
-        mean = self.acc_sum / self.block
+        mean, step_mean = self.acc_sum / self.block, self.step_sum / self.block
         self.acc_sum[:] = 0.0
+        self.step_sum[:] = 0.0
         self.in_block = 0
         with one_blas_thread():                 # the filters' products are small (blas module)
-            for obs, band, a in zip(self.observers, self.bands, mean):
+            for obs, band, a, y in zip(self.observers, self.bands, mean, step_mean):
                 # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g;
                 # once it has a model, only its spectrum is used (the band filter runs the model)
                 if obs.model is None:
@@ -149,8 +157,11 @@ class WaveCoast:
                 else:
                     obs.track_spectrum(float(a) - G, 0.0, 0.0)
                 if obs.model is not None and obs.model is not band.model:
+                    first = band.model is None
                     band.follow(obs.model, obs.xp)
-                band.accelerate(float(a))
+                    if first:               # the observer's state has taken this block already
+                        continue
+                band.accelerate(float(y))
         self.k_band = self.k
 
     def _start(self, dt: float) -> None:
@@ -211,6 +222,8 @@ class WaveCoast:
         """JSON-serialisable state."""
         return {
             "dt": self.dt, "block": self.block, "k": self.k, "acc_sum": self.acc_sum.tolist(),
+            "step_sum": self.step_sum.tolist(),
+            "last": None if self.last is None else self.last.tolist(),
             "in_block": self.in_block, "k_band": self.k_band, "k_fix": self.k_fix,
             "observers": [o.get_state() for o in self.observers],
             "bands": [b.get_state() for b in self.bands],
@@ -225,6 +238,8 @@ class WaveCoast:
         self.block, self.k, self.in_block, self.k_band = int(s["block"]), int(s["k"]), int(s["in_block"]), int(s["k_band"])
         self.k_fix = None if s["k_fix"] is None else int(s["k_fix"])
         self.acc_sum = np.array(s["acc_sum"], dtype=float)
+        self.step_sum = np.array(s["step_sum"], dtype=float)
+        self.last = None if s["last"] is None else np.array(s["last"], dtype=float)
         for o, st in zip(self.observers, s["observers"]):
             o.set_state(st)
         for b, o, st in zip(self.bands, self.observers, s["bands"]):
