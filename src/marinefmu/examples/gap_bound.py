@@ -20,11 +20,12 @@ relative to the last fix. It is trained on long records of the same sea with oth
 joint statistics, which an adaptive estimator would have to estimate) and scored on the
 dropouts. The fit knows the vessel's transfer functions and so the coherence between the
 channels — in a long-crested beam sea the roll that the gyro measures predicts the sway — which
-is why it does much better than the per-axis wave model. It is an estimate from above of the
-true linear bound (finite memory and training, 4 Hz block means), and from below of what an
-estimator that must learn the statistics on line can reach: refitted on the few minutes of
-fixes before each gap, the same fit errs 12.7 cm on average (30 s memory, 1 Hz) and 22.5 cm (60 s)
-over the 60 dropouts (a scan, README).
+is why it does much better than the per-axis wave model. It estimates the best linear
+estimator's error from above (finite memory and training, 4 Hz block means). An estimator that
+must learn the statistics in service cannot expect to reach it: refitted on the few minutes of
+fixes before each gap, the same fit errs 12.7 cm on average (30 s memory, 1 Hz) and 22.5 cm
+(60 s) over the 60 dropouts (a scan, README). So it shows the goal within reach in principle,
+and where the information is; it is not a floor that explains the wave coast's errors.
 
 Hand-written normal equations (numpy), as in :func:`~marinefmu.examples.paper003.causal_bound`:
 neither scipy nor python-control fits a multichannel causal Wiener filter from data.
