@@ -137,10 +137,7 @@ def gap_bound(cases=paper001.DROPOUTS, axis: str = "east", memory: float = 90.0,
     weights = fit(train, memory, taus)
     rows = []
     for start, seed in cases:
-        rec = paper001.simulate(start + duration + 10.0, {"gnss.rate": 1.0, "gnss.dropout.start": start,
-                                                          "gnss.dropout.duration": duration, "sea.seed": seed,
-                                                          "sensors.seed": seed})
-        d = prepare(rec, axis)
+        d = prepare(paper001.dropout_record(start, seed, duration), axis)
         err = max(abs(float(f @ weights[tau]) - z) for tau in taus for f, z in [row(d, start, tau, memory)])
         rows.append({"start": start, "seed": seed, "max_error_m": err})
     e = np.array([r["max_error_m"] for r in rows])

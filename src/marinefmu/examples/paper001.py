@@ -236,6 +236,13 @@ DROPOUTS = tuple((s, seed) for s in (270.0, 300.0, 320.0) for seed in range(1, 1
 LONG_DROPOUTS = tuple((270.0, seed) for seed in range(1, 5))
 
 
+def dropout_record(start: float, seed: int, duration: float = 30.0) -> dict[str, np.ndarray]:
+    """:func:`simulate` record of a ``duration`` s GNSS dropout at ``start`` s (1 Hz RTK, sea and
+    sensor ``seed``), running on 10 s after it."""
+    return simulate(start + duration + 10.0, {"gnss.rate": 1.0, "gnss.dropout.start": start,
+                                              "gnss.dropout.duration": duration, "sea.seed": seed, "sensors.seed": seed})
+
+
 def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict:
     """The fused real-time COG through a ``duration`` s GNSS dropout (1 Hz RTK, wave-model
     coast) for each (start, seed) of ``cases``: the largest error per axis [m] in the gap.
@@ -246,8 +253,7 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
     """
     rows = []
     for i, (start, seed) in enumerate(cases):
-        rec = simulate(start + duration + 10.0, {"gnss.rate": 1.0, "gnss.dropout.start": start,
-                                                 "gnss.dropout.duration": duration, "sea.seed": seed, "sensors.seed": seed})
+        rec = dropout_record(start, seed, duration)
         r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(), gnss_valid=rec["gnss_valid"])
         gap = slice(int(round(start / DT)), int(round((start + duration) / DT)))
         err = np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0)
