@@ -119,6 +119,11 @@ FUSION_PARAMETERS: list[Variable] = [
     real("coast_sigma", _FU.coast_sigma, "m", "Standard deviation of a wave-model pseudo-fix, (0, 10]"),
     real("coast_attitude_tau", _FU.coast_attitude_tau, "s", "Time constant of the coast's own PI attitude (coast = band, propagation = gyro), 0.1..10000"),
     real("coast_window", _FU.coast_window, "s", "Memory of the drift model of coast = band, 10..3600"),
+    Variable("coast_tilt", "boolean", _FU.coast_tilt, "", "Tilt-error states in the horizontal axes of coast = band (false: a loose offset takes the tilt, as before 2026-11-24)"),
+    real("gyro_bias_sigma", _FU.gyro_bias_sigma, "rad/s", "Gyro bias instability (Gauss-Markov standard deviation) for the tilt states, (0, 1]"),
+    real("gyro_bias_tau", _FU.gyro_bias_tau, "s", "Gyro bias correlation time for the tilt states, 0.1..1e6"),
+    real("antenna_sigma_h", _FU.antenna_sigma_h, "m", "Horizontal noise of one antenna position (the fix attitude's weight in the tilt states), (0, 100]"),
+    real("antenna_sigma_v", _FU.antenna_sigma_v, "m", "Vertical noise of one antenna position, (0, 100]"),
 ]
 FUSION_INPUTS: list[Variable] = [
     *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),
@@ -154,7 +159,8 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
         coast=v["coast"], coast_sigma=v["coast_sigma"], coast_attitude_tau=v["coast_attitude_tau"],
-        coast_window=v["coast_window"],
+        coast_window=v["coast_window"], coast_tilt=bool(v["coast_tilt"]), gyro_bias_sigma=v["gyro_bias_sigma"],
+        gyro_bias_tau=v["gyro_bias_tau"], antenna_sigma_h=v["antenna_sigma_h"], antenna_sigma_v=v["antenna_sigma_v"],
     )
 
 

@@ -47,8 +47,8 @@ east (30 dropouts below): the new model's steady-state covariance for the whole 
 fixes told is lost when the change falls at the start of a gap), and that covariance less the
 carried reduction the fixes made.
 
-Measured on the paper-001 set-up (1 Hz RTK, a 30 s dropout, max error through the gap of the
-fused real-time output; the coast's acceleration corrected with its own attitude
+Measured without the tilt states below (``coast_tilt`` false) on the paper-001 set-up (1 Hz
+RTK, a 30 s dropout, max error through the gap of the fused real-time output; the coast's acceleration corrected with its own attitude
 (``coast_attitude_tau`` 150 s of :class:`~.gnss_fusion.FusionParams`), spectrum window
 :data:`~.wave_coast.SPECTRUM_WINDOW` 180 s, the step means of :meth:`WaveCoast.add
 <.wave_coast.WaveCoast.add>`; ``make bench``, part ``dropout``, 2026-11-24; in brackets before
@@ -65,26 +65,67 @@ the step-mean fix of that day, then the fusion's attitude and a 120 s window):
   14.6 cm). The best linear estimator that knows the joint statistics of the sea and the
   sensors errs far less on the same dropouts (:mod:`marinefmu.examples.gap_bound`).
 
-What is left on east comes from the attitude that corrects the coast's acceleration. The
-horizontal offset (:data:`~.wave_coast.HORIZONTAL_OFFSET_NOISE`) must follow g × that
-attitude's error — the fix noise the PI lets through, and in a gap the tilt the gyro bias
-error builds (0.9 → 3.7 mrad in 25 s on seed 9 at 270 s with the fusion's attitude) — and a
-loose offset takes a few percent of the sway at the wave peak (|1 − H| 3 % at 0.77 rad/s, 13 %
-at 1.3 rad/s). Given the true attitude, the heave observer's offset noise does, and that
-dropout errs 6.6 cm (15.2 cm with the fusion's attitude and a 120 s window, 9.4 cm before the
-step-mean fix).
-Lower offset noise, an offset-rate state, another offset noise in gaps only, a smoothed
-spectrum, and the fixes' attitude as a measurement of the offset were measured and not taken
+Tilt states (2026-11-24, :class:`Tilt`, ``coast_tilt`` of
+:class:`~.gnss_fusion.FusionParams`). The horizontal acceleration is off by g × the error of
+the attitude that corrects it, ε: east by −g·ε_N, north by +g·ε_E (checked on the paper-001
+record: the 20 s means of a_used − a_true equal g·ε to 0.5 mm/s², with ε 1-4 mrad and the
+accelerometer bias under 1 mm/s²). Until then a loose random-walk offset
+(:data:`~.wave_coast.HORIZONTAL_OFFSET_NOISE`, ten times the heave observer's) stood in for
+g·ε, and took a few percent of the sway at the wave peak with it (|1 − H| 3 % at 0.77 rad/s).
+Now the north and east filters carry ε and the gyro-bias error δ that turns it,
+
+    ε̇ = δ,  δ Gauss-Markov (the gyro's bias instability and correlation time),
+
+with ``gain``·ε in the acceleration row (and −J·gain in Ā, the increment form's feed-through),
+measured at every fix by the antenna attitude's error against the coast's attitude (σ from the
+antenna geometry, :func:`~.gnss_fusion.antenna_attitude_std`: 1.9 / 0.75 mrad about N / E on
+the paper-001 set-up, as measured). The coast's PI pulls move ε and δ by known amounts
+(:meth:`AidedBand.shift_tilt`). The offset keeps the heave observer's noise (1e-4), the
+accelerometer bias alone; at the first band model it restarts at 0 ± 2 mm/s², because the
+observer's own offset had taken g·ε (started on it, ε was estimated 1.5 mrad off on seed 27;
+restarted, 0.24 / 0.15 mrad RMS about N / E over 190 s, with the 1.3 → 4.2 mrad growth of ε_N
+through the gap followed to 0.5 mrad). On a synthetic tilt swing the gap error halves
+(test). Over the 60 dropouts (scan, 2026-11-24): east at 10 cm or more in 2 instead of 4
+(seed 27 at 350 s 11.8 cm instead of 15.4, seed 36 10.8 instead of 8.0), mean N / E / D
+2.1 / 6.6 / 3.1 cm (1.9 / 6.6 / 3.1). An offset noise of 3e-4 with the tilt states: also 2
+(12.2 cm worst, mean east 6.6 cm).
+
+What is left on east is at the wave frequency: through seed 27's gap the error swings ±9 cm
+at the 8 s peak period on a ±1.5 m sway (±4 cm with the true attitude). What tells the sway
+in a gap beyond the acceleration is the roll the gyro measures
+(:mod:`marinefmu.examples.gap_bound`); this filter does not use it. Measured and not taken
+before the tilt states: lower offset noise, an offset-rate state, another offset noise in gaps
+only, a smoothed spectrum, and the fixes' attitude as a measurement of the offset itself
 (README, paper 001).
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from filterpy.common import Q_continuous_white_noise
 
 from .oscillator_bank import BankModel, carry_map
+
+
+@dataclass(frozen=True)
+class Tilt:
+    """The tilt error of the attitude that corrects the axis's acceleration, as two states.
+
+    ε [rad] is the component of that attitude's error (n frame, true = exp(ε)·used) whose
+    g-multiple lands on this axis: the axis's acceleration is off by ``gain``·ε (east −g·ε_N,
+    north +g·ε_E; :class:`~.wave_coast.WaveCoast`). It grows with the gyro-bias error
+    δ [rad/s], ε̇ = δ, a Gauss-Markov process of standard deviation ``bias_sigma`` and
+    correlation time ``bias_tau`` (the gyro's datasheet). Each GNSS fix's antenna attitude
+    measures ε (:meth:`AidedBand.attitude_fix`).
+    """
+
+    gain: float                       # [m/s²/rad]
+    bias_sigma: float                 # [rad/s]
+    bias_tau: float                   # [s]
+    prior: float = 5e-3               # standard deviation of ε at a start [rad]
+    offset_prior: float = 2e-3        # standard deviation of the offset at the first model [m/s²]
 
 #: Standard deviation of a GNSS position of the accelerometer point, per axis [m]. Four RTK
 #: antennas (1 cm) average to 0.5 cm, and the lever arm turned with the propagated attitude adds
@@ -128,14 +169,19 @@ class AidedBand:
     1.5
     """
 
-    def __init__(self, q_drift: float, dt: float) -> None:
+    def __init__(self, q_drift: float, dt: float, tilt: Tilt | None = None) -> None:
         self.q_drift = float(q_drift)
         self.dt = float(dt)
+        self.tilt = tilt
+        self.n_extra = 2 if tilt is None else 4     # drift (and tilt) states after the band
         self.model: BankModel | None = None
         self.fixes = 0                      # fixes since the last drift restart
         self._configure()
-        self.x = np.zeros(2)                # state (module docstring)
-        self.P = np.diag(np.square(DRIFT_PRIOR))
+        self.x = np.zeros(self.n_extra)     # state (module docstring)
+        prior = list(np.square(DRIFT_PRIOR))
+        if tilt is not None:
+            prior += [tilt.prior ** 2, tilt.bias_sigma ** 2]
+        self.P = np.diag(prior)
 
     # ---- model -------------------------------------------------------------------------------
     @property
@@ -146,22 +192,32 @@ class AidedBand:
     def _configure(self) -> None:
         """Transition F, feed-through J, process noise Q and acceleration row C of the current
         model plus the drift."""
-        m, n = self.model, self.n_band
-        self.F = np.eye(n + 2)
-        self.F[-2, -1] = self.dt
-        self.Q = np.zeros((n + 2, n + 2))
-        self.Q[-2:, -2:] = Q_continuous_white_noise(2, self.dt, self.q_drift)
-        self.J = np.zeros(n + 2)
-        self.C = np.zeros(n + 2)
+        m, n, t = self.model, self.n_band, self.tilt
+        size = n + self.n_extra
+        d = n                               # drift position, velocity at d, d + 1
+        self.F = np.eye(size)
+        self.F[d, d + 1] = self.dt
+        self.Q = np.zeros((size, size))
+        self.Q[d:d + 2, d:d + 2] = Q_continuous_white_noise(2, self.dt, self.q_drift)
+        self.J = np.zeros(size)
+        self.C = np.zeros(size)
         if m is not None:
             self.F[:n, :n] = m.A_bar
             self.J[:n] = m.J
             self.Q[:n, :n] = m.Q
             self.C[:n] = m.C
-        self.rows = np.zeros((2, n + 2))    # position and velocity of the axis
+        if t is not None:                   # ε at d + 2, δ at d + 3
+            phi = math.exp(-self.dt / t.bias_tau)
+            self.F[d + 2, d + 3] = t.bias_tau * (1.0 - phi)
+            self.F[d + 3, d + 3] = phi
+            self.Q[d + 3, d + 3] = t.bias_sigma ** 2 * (1.0 - phi * phi)
+            self.C[d + 2] = t.gain
+            # decorrelated increment form: Ā = A − J C over the tilt's column too
+            self.F[:n, d + 2] = -self.J[:n] * t.gain
+        self.rows = np.zeros((2, size))     # position and velocity of the axis
         if m is not None:
             self.rows[:, :n] = m.heave_rows
-        self.rows[0, -2] = self.rows[1, -1] = 1.0
+        self.rows[0, d] = self.rows[1, d + 1] = 1.0
 
     def follow(self, model: BankModel, band_state: np.ndarray) -> None:
         """Adopt the band observer's (new) model, built for this filter's step.
@@ -170,9 +226,9 @@ class AidedBand:
         window) with the model's steady-state covariance; a later one carries state and
         covariance over (module docstring).
         """
-        old, n_new = self.model, model.n
-        t = np.zeros((n_new + 2, self.n_band + 2))
-        t[-2:, -2:] = np.eye(2)
+        old, n_new, e = self.model, model.n, self.n_extra
+        t = np.zeros((n_new + e, self.n_band + e))
+        t[-e:, -e:] = np.eye(e)
         if old is not None:
             t[:n_new, :old.n] = carry_map(old.omega, model.omega, model.block)
         x, p = t @ self.x, t @ self.P @ t.T
@@ -182,6 +238,14 @@ class AidedBand:
         p[fresh, :] = 0.0
         p[:, fresh] = 0.0
         p[np.ix_(fresh, fresh)] = model.P[np.ix_(fresh, fresh)]
+        if old is None and self.tilt is not None:
+            # the observer's offset holds the tilt's g·ε as well: start it at 0 with the
+            # accelerometer-bias prior and let the tilt states take the rest (Tilt)
+            o = n_new - 1
+            x[o] = 0.0
+            p[o, :] = 0.0
+            p[:, o] = 0.0
+            p[o, o] = self.tilt.offset_prior ** 2
         self.model = model
         self._configure()
         self.x, self.P = x, p
@@ -210,6 +274,26 @@ class AidedBand:
         states' time (the end of the last band step); ``sigma`` its standard deviation [m]."""
         self._update(z, self._row(lead), sigma**2)
         self.fixes += 1
+
+    def attitude_fix(self, e: float, sigma: float, lead: float) -> None:
+        """Update the tilt states with the attitude error ``e`` [rad] that a GNSS fix's antenna
+        attitude measured with standard deviation ``sigma`` [rad], ``lead`` s after the band
+        states' time (:class:`Tilt`)."""
+        if self.tilt is None:
+            return
+        h = np.zeros(len(self.x))
+        i = self.n_band + 2
+        h[i], h[i + 1] = 1.0, lead
+        self._update(e, h, sigma ** 2)
+
+    def shift_tilt(self, d_eps: float, d_rate: float) -> None:
+        """The attitude was corrected: its error moved by ``d_eps`` [rad] and the gyro-bias
+        error by ``d_rate`` [rad/s] (known, so the covariance stays)."""
+        if self.tilt is None:
+            return
+        i = self.n_band + 2
+        self.x[i] += d_eps
+        self.x[i + 1] += d_rate
 
     def position(self, lead: float) -> float:
         """Position of the axis [m] ``lead`` s after the band states' time (moved on by the rate)."""
@@ -240,12 +324,19 @@ class AidedBand:
         self.P = 0.5 * (p + p.T)
 
     def restart_drift(self) -> None:
-        """Forget the drift (the fusion re-initialised: a real reposition)."""
-        x, p = self.x, self.P
-        p[-2:, :] = 0.0
-        p[:, -2:] = 0.0
-        p[-2:, -2:] = np.diag(np.square(DRIFT_PRIOR))
-        x[-2:] = 0.0
+        """Forget the drift and the tilt (the fusion re-initialised on a fix: a real reposition,
+        and the attitude restarts on the fix's)."""
+        x, p, d = self.x, self.P, slice(self.n_band, self.n_band + 2)
+        p[d, :] = 0.0
+        p[:, d] = 0.0
+        p[d, d] = np.diag(np.square(DRIFT_PRIOR))
+        x[d] = 0.0
+        if self.tilt is not None:           # the attitude restarts on the fix as well
+            i = self.n_band + 2
+            p[i, :] = 0.0
+            p[:, i] = 0.0
+            p[i, i] = self.tilt.prior ** 2
+            x[i] = 0.0
         self.fixes = 0
 
     # ---- state -------------------------------------------------------------------------------

@@ -31,8 +31,12 @@ breaks the drift assumption: use ``coast="inertial"`` in :class:`~.gnss_fusion.F
 then. :class:`~.gnss_fusion.GnssAccFusion` feeds the coast position to its Kalman filter as a
 pseudo-fix every 0.1 s while GNSS is missing.
 
-The horizontal observers use ``offset_noise`` :data:`HORIZONTAL_OFFSET_NOISE`, ten times the
-heave default: the horizontal a_n carries g × the attitude error of the antenna fixes (about
+With tilt states (``tilt``; the default of :class:`~.gnss_fusion.GnssAccFusion` since
+2026-11-24) the north and east filters carry the tilt error of the correcting attitude
+explicitly (:class:`~.aided_band.Tilt`), measured by each fix's antenna attitude
+(:meth:`WaveCoast.attitude_fix`), and all three observers keep the heave observer's offset
+noise. Without them the horizontal observers use ``offset_noise``
+:data:`HORIZONTAL_OFFSET_NOISE`, ten times the heave default: the horizontal a_n carries g × the attitude error of the antenna fixes (about
 5 mm/s² RMS at 0.1-0.25 rad/s with 1 cm fixes on an 8 m baseline) and, in a gap, g × the
 gyro-propagated tilt drift, which a weaker offset leaves to the lowest band elements as
 displacement (with the aided filter, over the 30 dropouts of :mod:`.aided_band`, east over
@@ -46,7 +50,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..frames import G
-from .aided_band import AidedBand, drift_noise
+from .aided_band import AidedBand, Tilt, drift_noise
 from .blas import one_blas_thread
 from .heave import HeaveObserver, HeaveObserverParams
 
@@ -95,6 +99,9 @@ class WaveCoast:
     spectrum_window : float
         Spectrum window of the band observers [s] (:data:`SPECTRUM_WINDOW`); no position
         before it has passed, ≥ 4π/``omega_min`` of the heave observer (50.3 s).
+    tilt : tuple of float, optional
+        (σ [rad/s], τ [s]) of the gyro-bias error for tilt states in the north and east
+        filters (module docstring); None: none, and a loose horizontal offset.
 
     Examples
     --------
@@ -104,16 +111,19 @@ class WaveCoast:
     True
     """
 
-    def __init__(self, window: float, spectrum_window: float = SPECTRUM_WINDOW) -> None:
+    def __init__(self, window: float, spectrum_window: float = SPECTRUM_WINDOW,
+                 tilt: tuple[float, float] | None = None) -> None:
         self.window = float(window)
         self.spectrum_window = float(spectrum_window)
+        self.tilt = tilt
         self.reset()
 
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
         vertical = HeaveObserverParams(model="band", smoother_lag=0.0, peak_interval=PEAK_INTERVAL, window=self.spectrum_window,
                                        window_max=self.spectrum_window, band_min=BAND_MIN, band_variance="point")
-        horizontal = replace(vertical, offset_noise=HORIZONTAL_OFFSET_NOISE)
+        # with tilt states the offset takes only the accelerometer bias, as on the vertical
+        horizontal = vertical if self.tilt is not None else replace(vertical, offset_noise=HORIZONTAL_OFFSET_NOISE)
         self.observers = [HeaveObserver(horizontal, quiet=True), HeaveObserver(horizontal, quiet=True),
                           HeaveObserver(vertical, quiet=True)]
         self.dt: float | None = None
@@ -167,7 +177,12 @@ class WaveCoast:
     def _start(self, dt: float) -> None:
         self.dt = float(dt)
         self.block = max(1, int(round(1.0 / (RATE * dt))))
-        self.bands = [AidedBand(drift_noise(self.window), self.block * self.dt) for _ in range(3)]
+        tilts: list[Tilt | None] = [None, None, None]
+        if self.tilt is not None:
+            sigma, tau = self.tilt
+            # north a_n is off by +g·ε_E, east by −g·ε_N (class docstring)
+            tilts = [Tilt(G, sigma, tau), Tilt(-G, sigma, tau), None]
+        self.bands = [AidedBand(drift_noise(self.window), self.block * self.dt, t) for t in tilts]
 
     @property
     def ready(self) -> bool:
@@ -188,6 +203,24 @@ class WaveCoast:
         for band, zi in zip(self.bands, np.asarray(z, dtype=float)):
             band.fix(float(zi), lead)
         self.k_fix = self.k
+
+    def attitude_fix(self, e_n: np.ndarray, sigma_n: np.ndarray) -> None:
+        """Update the tilt states with the error of the correcting attitude that a fix's antenna
+        attitude measured, e_n [rad, NED rotation vector, true = exp(e_n)·used], of standard
+        deviations ``sigma_n`` [rad, NED] (:func:`~.gnss_fusion.antenna_attitude_std`)."""
+        if not self.ready or self.tilt is None:
+            return
+        lead = self._lead()
+        self.bands[0].attitude_fix(float(e_n[1]), float(sigma_n[1]), lead)
+        self.bands[1].attitude_fix(float(e_n[0]), float(sigma_n[0]), lead)
+
+    def shift_tilt(self, d_eps: np.ndarray, d_rate: np.ndarray) -> None:
+        """The correcting attitude was pulled: its error moved by ``d_eps`` [rad, NED] and the
+        gyro-bias error by ``d_rate`` [rad/s, NED]."""
+        if self.tilt is None:
+            return
+        self.bands[0].shift_tilt(float(d_eps[1]), float(d_rate[1]))
+        self.bands[1].shift_tilt(float(d_eps[0]), float(d_rate[0]))
 
     def forget_position(self) -> None:
         """Forget the drift (the fusion re-initialised: a real reposition)."""
