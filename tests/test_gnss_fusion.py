@@ -201,11 +201,11 @@ def test_a_20_m_jump_is_gated_out():
 def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 180 s spectrum window and 120 s
     of fixes before it). Real time with ``coast="band"`` (default, the GNSS-aided band observer
-    of estimators.aided_band, on its own slower attitude): measured max per axis 1.8-4.3 /
-    3.6-9.6 / 3.1-5.9 cm north / east / down over seeds 1-3 (the line coast before it: east
-    8.4 / 3.8 / 11.2 cm), against metres for the inertial coast (README). The goal, 10 cm per
-    axis, is the bound. RTS-smoothed through the gap: measured max 1.3-2.7 / 3.6-6.3 /
-    2.1-4.1 cm (bound 10 cm). Back within 5 cm (3-D)
+    of estimators.aided_band with its tilt states, on its own slower attitude): measured max
+    per axis 1.9-4.3 / 5.0-8.7 / 2.2-3.0 cm north / east / down over seeds 1-3 (2026-11-24;
+    the line coast before it: east 8.4 / 3.8 / 11.2 cm), against metres for the inertial coast
+    (README). The goal, 10 cm per axis, is the bound. RTS-smoothed through the gap: measured
+    max 1.1-2.7 / 4.4-5.3 / 1.8-2.6 cm (bound 10 cm). Back within 5 cm (3-D)
     5 s after the fixes return, and valid throughout (within max_coast)."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
                                     "sea.seed": seed, "sensors.seed": seed})
@@ -236,13 +236,13 @@ def test_inertial_coast_drifts_as_the_gyro_floor_says():
 
 def test_five_minute_dropout_is_bridged_by_the_wave_coast():
     """1 Hz GNSS, 300 s dropout at 270 s, seed 2 (the worse of seeds 1-2). The wave coast gives
-    pseudo-fixes through the whole gap: max error per axis measured 12.7 / 22.6 / 9.0 cm
-    (bound 40 cm; the inertial coast used to take over after ``coast_window``, 120 s, and was
-    kilometres off). ``pos_std`` takes the coast's own standard deviation: 21 cm at the end,
-    above the error then. ``valid`` is false after ``max_coast``; the first fix re-initialises
-    the filter with the coasted velocity (15 / 18 / 2 cm in the first 5 s, against 2 / 32 /
-    40 cm for a restart at rest) and from 5 s later the error is back under 3 cm (measured
-    2.1 / 1.8 / 2.0 cm; bound 5 cm)."""
+    pseudo-fixes through the whole gap: max error per axis measured 13.1 / 22.6 / 5.7 cm
+    (2026-11-24; bound 40 cm; the inertial coast used to take over after ``coast_window``,
+    120 s, and was kilometres off). ``pos_std`` takes the coast's own standard deviation:
+    21 cm at the end, above the error then (11 / 14 / 4 cm). ``valid`` is false after
+    ``max_coast``; the first fix re-initialises the filter with the coasted velocity (15 / 18 /
+    2 cm in the first 5 s, against 2 / 32 / 40 cm for a restart at rest) and from 5 s later the
+    error is back under 3 cm (measured 2.1 / 1.8 / 2.0 cm; bound 5 cm)."""
     start, dur = 270.0, 300.0
     rec = paper001.simulate(start + dur + 30.0, {"gnss.rate": 1.0, "gnss.dropout.start": start,
                                                  "gnss.dropout.duration": dur, "sea.seed": 2, "sensors.seed": 2})

@@ -84,11 +84,12 @@ the paper-001 set-up, as measured). The coast's PI pulls move ε and δ by known
 accelerometer bias alone; at the first band model it restarts at 0 ± 2 mm/s², because the
 observer's own offset had taken g·ε (started on it, ε was estimated 1.5 mrad off on seed 27;
 restarted, 0.24 / 0.15 mrad RMS about N / E over 190 s, with the 1.3 → 4.2 mrad growth of ε_N
-through the gap followed to 0.5 mrad). On a synthetic tilt swing the gap error halves
-(test). Over the 60 dropouts (scan, 2026-11-24): east at 10 cm or more in 2 instead of 4
-(seed 27 at 350 s 11.8 cm instead of 15.4, seed 36 10.8 instead of 8.0), mean N / E / D
-2.1 / 6.6 / 3.1 cm (1.9 / 6.6 / 3.1). An offset noise of 3e-4 with the tilt states: also 2
-(12.2 cm worst, mean east 6.6 cm).
+through the gap followed to 0.5 mrad). On a synthetic tilt swing the gap error falls from
+9.1-9.3 to 4.8-5.6 cm (test). Over the 60 dropouts (``make bench``, part ``dropout``,
+2026-11-24): east at 10 cm or more in 2 instead of 4 (seed 27 at 350 s 11.8 cm instead of
+15.4, seed 36 10.8 instead of 8.0), mean N / E / D 2.0 / 6.6 / 3.1 cm (1.9 / 6.6 / 3.1).
+Scans: with an offset noise of 3e-4 also 2 (12.2 cm worst, mean east 6.6 cm);
+``gyro_bias_sigma`` 1e-4, 3; ``coast_attitude_tau`` 50 s, 3 (13.1 cm).
 
 What is left on east is at the wave frequency: through seed 27's gap the error swings ±9 cm
 at the 8 s peak period on a ±1.5 m sway (±4 cm with the true attitude). What tells the sway
