@@ -89,16 +89,18 @@ def test_a_new_element_set_keeps_the_position_and_its_rate():
     assert np.all(np.linalg.eigvalsh(f.P) > -1e-12)
 
 
-def test_coast_state_round_trips_through_json():
+@pytest.mark.parametrize("tilt", [None, (5e-5, 50.0)])
+def test_coast_state_round_trips_through_json(tilt):
     """Save 10 s after the first spectrum (JSON, as the FMU does), run both copies on for 50 s:
-    the coast positions are bit-identical."""
+    the coast positions are bit-identical, with and without tilt states (given attitude fixes
+    and PI shifts)."""
     save = SPECTRUM_WINDOW + 10.0
     t = DT * np.arange(1, int((save + 50.0) / DT) + 1)
     w = 2 * math.pi / 9.0
     acc = np.stack([-0.4 * w * w * np.sin(w * t + p) for p in (0.0, 1.0, 2.0)], axis=1)
     pos = np.stack([0.4 * np.sin(w * t + p) for p in (0.0, 1.0, 2.0)], axis=1)
-    a = WaveCoast(120.0)
-    b = WaveCoast(120.0)
+    a = WaveCoast(120.0, tilt=tilt)
+    b = WaveCoast(120.0, tilt=tilt)
     out_a, out_b = [], []
     for k in range(len(t)):
         if k == int(save / DT):
@@ -109,6 +111,8 @@ def test_coast_state_round_trips_through_json():
             c.add(acc[k], DT)
             if k % 20 == 19:
                 c.anchor(pos[k])
+                c.attitude_fix(np.array([1e-3, -2e-3, 0.0]), np.array([2e-3, 1e-3, 5e-4]))
+                c.shift_tilt(np.array([-1e-5, 2e-5, 0.0]), np.array([1e-7, -1e-7, 0.0]))
             if k >= int(save / DT):
                 out.append(c.position())
     assert out_a[-1] is not None
