@@ -13,7 +13,7 @@ measured). The states need one covariance that knows both measurement types.
 
 Model. One Kalman filter with the state
 
-    x = [band elements …, offset, drift position p_d, drift velocity v_d]
+    x = [band elements …, offset, drift position p_d, drift velocity v_d (, tilt ε, rate δ)]
 
 * the band elements and the offset are the band observer's model
   (:func:`~.band_bank.build_band_bank`: damped resonators weighted by the measured spectrum, a
@@ -48,8 +48,8 @@ fixes told is lost when the change falls at the start of a gap), and that covari
 carried reduction the fixes made.
 
 Measured without the tilt states below (``coast_tilt`` false) on the paper-001 set-up (1 Hz
-RTK, a 30 s dropout, max error through the gap of the fused real-time output; the coast's acceleration corrected with its own attitude
-(``coast_attitude_tau`` 150 s of :class:`~.gnss_fusion.FusionParams`), spectrum window
+RTK, a 30 s dropout, max error through the gap of the fused real-time output; the coast's
+acceleration corrected with its own attitude (``coast_attitude_tau`` 150 s of :class:`~.gnss_fusion.FusionParams`), spectrum window
 :data:`~.wave_coast.SPECTRUM_WINDOW` 180 s, the step means of :meth:`WaveCoast.add
 <.wave_coast.WaveCoast.add>`; ``make bench``, part ``dropout``, 2026-11-24; in brackets before
 the step-mean fix of that day, then the fusion's attitude and a 120 s window):
@@ -192,7 +192,7 @@ class AidedBand:
 
     def _configure(self) -> None:
         """Transition F, feed-through J, process noise Q and acceleration row C of the current
-        model plus the drift."""
+        model plus the drift (and the tilt states)."""
         m, n, t = self.model, self.n_band, self.tilt
         size = n + self.n_extra
         d = n                               # drift position, velocity at d, d + 1

@@ -51,7 +51,9 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    for a floating platform or a vessel on station: the low-frequency position moves along a
    straight line through the gap. Once no fix has come for :data:`COAST_AFTER` s, the
    position of :class:`~.wave_coast.WaveCoast` (per axis, the band observer's wave model and a
-   drift in one Kalman filter that the fixes update too, :mod:`.aided_band`) updates the filter every
+   drift in one Kalman filter that the fixes update too, :mod:`.aided_band`; in the north and
+   east filters also the tilt error of the attitude that corrects the coast's acceleration,
+   ``coast_tilt``) updates the filter every
    :data:`COAST_INTERVAL` s as a pseudo-fix (not gated; ``fix`` is ``"wave"``) of variance
    ``coast_sigma``² plus the coast's own (which grows through the gap), until GNSS returns,
    however long the gap: on the paper's set-up a 5-min gap errs 23 cm at most (seeds 1-4),

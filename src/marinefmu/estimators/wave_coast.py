@@ -36,10 +36,10 @@ With tilt states (``tilt``; the default of :class:`~.gnss_fusion.GnssAccFusion` 
 explicitly (:class:`~.aided_band.Tilt`), measured by each fix's antenna attitude
 (:meth:`WaveCoast.attitude_fix`), and all three observers keep the heave observer's offset
 noise. Without them the horizontal observers use ``offset_noise``
-:data:`HORIZONTAL_OFFSET_NOISE`, ten times the heave default: the horizontal a_n carries g × the attitude error of the antenna fixes (about
-5 mm/s² RMS at 0.1-0.25 rad/s with 1 cm fixes on an 8 m baseline) and, in a gap, g × the
-gyro-propagated tilt drift, which a weaker offset leaves to the lowest band elements as
-displacement (with the aided filter, over the 30 dropouts of :mod:`.aided_band`, east over
+:data:`HORIZONTAL_OFFSET_NOISE`, ten times the heave default: the horizontal a_n carries g ×
+the attitude error of the antenna fixes (about 5 mm/s² RMS at 0.1-0.25 rad/s with 1 cm fixes
+on an 8 m baseline) and, in a gap, g × the gyro-propagated tilt drift, which a weaker offset
+leaves to the lowest band elements as displacement (with the aided filter, over the 30 dropouts of :mod:`.aided_band`, east over
 10 cm in 28 / 14 / 5 with 1e-4 / 3e-4 / 1e-3; 1e-3 raised to 3e-3 in gaps only: 12).
 """
 from __future__ import annotations
