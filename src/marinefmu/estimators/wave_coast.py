@@ -81,12 +81,16 @@ PEAK_INTERVAL = 60.0
 #: 40 dropouts of :mod:`.aided_band` east over 10 cm in 1 (10.3 cm instead of 10.6), mean
 #: 6.8 cm as before; 5-min dropouts worst N / E / D 12.4 / 22.6 / 13.9 cm (12.7 / 22.6 / 13.3).
 BAND_MIN = 0.25
-#: The band observers keep the heave observer's settings of before 2026-11-23 for the same
-#: reason: a fixed :data:`SPECTRUM_WINDOW` (``window_max`` = window) and element variances read
-#: at the element's frequency (``band_variance = "point"``). With the variances integrated
-#: (``marinefmu bench --parts dropout``, 2026-11-23) the 40 dropouts moved by noise only, mean
-#: N / E / D 2.0 / 6.8 / 4.2 cm as before, but east reached 10.0 cm at seed 9 / 270 s (9.5) and
-#: 10.7 at seed 9 / 320 s (10.6): 2 of 40 at 10 cm or more instead of 1.
+#: The band observers' spectrum. With tilt states (the default) they take the heave observer's
+#: own settings: the window grows from :data:`SPECTRUM_WINDOW` with the data up to its
+#: ``window_max`` (:data:`~.heave.WINDOW_MAX`) and the element variances are integrated over
+#: their bands. With the tilt states that made the spectrum count: over the 60 dropouts of
+#: :mod:`.aided_band` east at 10 cm or more in 1 instead of 2, mean east 6.3 instead of 6.6 cm
+#: (a scan, 2026-11-24; ``make bench`` in the README). Without tilt states they keep the old
+#: settings, a fixed window (``window_max`` = window) and variances read at the element's
+#: frequency (``band_variance = "point"``): with the loose offset, integrated variances moved
+#: the 40 dropouts of 2026-11-23 by noise only (``marinefmu bench --parts dropout``: mean
+#: N / E / D 2.0 / 6.8 / 4.2 cm as before, 2 of 40 at 10 cm or more instead of 1).
 
 
 class WaveCoast:
@@ -120,8 +124,10 @@ class WaveCoast:
 
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
-        vertical = HeaveObserverParams(model="band", smoother_lag=0.0, peak_interval=PEAK_INTERVAL, window=self.spectrum_window,
-                                       window_max=self.spectrum_window, band_min=BAND_MIN, band_variance="point")
+        # spectrum: with tilt states the heave observer's own settings, without them its old ones
+        old = {} if self.tilt is not None else {"window_max": self.spectrum_window, "band_variance": "point"}
+        vertical = HeaveObserverParams(model="band", smoother_lag=0.0, peak_interval=PEAK_INTERVAL,
+                                       window=self.spectrum_window, band_min=BAND_MIN, **old)
         # with tilt states the offset takes only the accelerometer bias, as on the vertical
         horizontal = vertical if self.tilt is not None else replace(vertical, offset_noise=HORIZONTAL_OFFSET_NOISE)
         self.observers = [HeaveObserver(horizontal, quiet=True), HeaveObserver(horizontal, quiet=True),
