@@ -180,8 +180,9 @@ class FusionParams:
         accelerometer bias. False: a loose offset stands in for the tilt (until 2026-11-24).
         Needs ``coast="band"``, ``propagation="gyro"`` and the attitude correction. Over the
         60 dropouts of the README (paper 001): east at 10 cm or more in 2 instead of 4, worst
-        11.8 cm instead of 15.4 cm, mean unchanged (6.6 cm; ``make bench``, part ``dropout``,
-        2026-11-24). [``coast_tilt``]
+        11.8 cm instead of 15.4 cm, mean unchanged (6.6 cm); with the heave observer's spectrum
+        settings that the tilt states bring (:mod:`.wave_coast`) 1, 10.7 cm, mean 6.3 cm
+        (``make bench``, part ``dropout``, 2026-11-24). [``coast_tilt``]
     gyro_bias_sigma : float
         Gyro bias instability, the Gauss-Markov standard deviation of the tilt states' bias
         error [rad/s], (0, 1] (VesselMotion's default 5e-5; 1e-4 coasted worse: 3 of 60 over
