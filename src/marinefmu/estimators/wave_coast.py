@@ -60,9 +60,10 @@ RATE = 20.0
 HORIZONTAL_OFFSET_NOISE = 1e-3
 #: Fewest fixes before the coast gives a position.
 MIN_FIXES = 3
-#: Spectrum window of the band observers [s]: the coast gives positions from this long into a
-#: run. Measured with the fusion's attitude, before ``coast_attitude_tau`` (max east error through a 30 s dropout at 1 Hz, paper-001 set-up, fused real
-#: time): over the 30 dropouts at 270 / 300 / 320 s of seeds 1-10, over 10 cm in 5 with the
+#: First spectrum window of the band observers [s] (with tilt states it then grows, below): the
+#: coast gives positions from this long into a run. Measured with the fusion's attitude, before
+#: ``coast_attitude_tau`` (max east error through a 30 s dropout at 1 Hz, paper-001 set-up,
+#: fused real time): over the 30 dropouts at 270 / 300 / 320 s of seeds 1-10, over 10 cm in 5 with the
 #: heave observer's 120 s (mean 7.9 cm, worst 15.2), 2 with 180 s (7.1 cm, worst 13.7) and
 #: 2 with 240 s (7.3 cm, worst 14.1); on 10 more (seeds 11-20 at 400 s, not used to choose)
 #: 2 over 10 cm with 120 s (mean 8.2 cm) and 3 with 180 s (7.6 cm, all three 10.2-10.5 cm).
@@ -101,7 +102,7 @@ class WaveCoast:
     window : float
         Memory of the drift model [s] (:func:`~.aided_band.drift_noise`), > 0.
     spectrum_window : float
-        Spectrum window of the band observers [s] (:data:`SPECTRUM_WINDOW`); no position
+        First spectrum window of the band observers [s] (:data:`SPECTRUM_WINDOW`); no position
         before it has passed, ≥ 4π/``omega_min`` of the heave observer (50.3 s).
     tilt : tuple of float, optional
         (σ [rad/s], τ [s]) of the gyro-bias error for tilt states in the north and east
