@@ -141,6 +141,16 @@ FIX_SIGMA = 0.02
 DRIFT_PRIOR = (10.0, 1.0)
 
 
+def restart(x: np.ndarray, p: np.ndarray, idx, cov: np.ndarray, value: np.ndarray | float = 0.0) -> None:
+    """Restart the states ``idx`` of (x, P) in place at ``value`` with covariance ``cov``,
+    uncorrelated with the rest."""
+    idx = np.asarray(idx, dtype=int)
+    p[idx, :] = 0.0
+    p[:, idx] = 0.0
+    p[np.ix_(idx, idx)] = cov
+    x[idx] = value
+
+
 def drift_noise(window: float, sigma: float = FIX_SIGMA, fix_interval: float = 1.0) -> float:
     """Acceleration density q_d [m²/s³] of the drift model that remembers about ``window`` s.
 
@@ -240,17 +250,12 @@ class AidedBand:
         if old is None:
             x[:n_new] = band_state
         fresh = np.flatnonzero(~t[:n_new].any(axis=1))
-        p[fresh, :] = 0.0
-        p[:, fresh] = 0.0
-        p[np.ix_(fresh, fresh)] = model.P[np.ix_(fresh, fresh)]
+        restart(x, p, fresh, model.P[np.ix_(fresh, fresh)], x[fresh])
         if old is None and self.tilt is not None:
             # the observer's offset holds the tilt's g·ε as well: start it at 0 with the
             # accelerometer-bias prior and let the tilt states take the rest (Tilt)
-            o = n_new - 1
-            x[o] = 0.0
-            p[o, :] = 0.0
-            p[:, o] = 0.0
-            p[o, o] = self.tilt.offset_prior ** 2
+            o = [n_new - 1]
+            restart(x, p, o, np.diag([self.tilt.offset_prior ** 2]))
         self.model = model
         self._configure()
         self.x, self.P = x, p
@@ -331,17 +336,10 @@ class AidedBand:
     def restart_drift(self) -> None:
         """Forget the drift and the tilt (the fusion re-initialised on a fix: a real reposition,
         and the attitude restarts on the fix's)."""
-        x, p, d = self.x, self.P, slice(self.n_band, self.n_band + 2)
-        p[d, :] = 0.0
-        p[:, d] = 0.0
-        p[d, d] = np.diag(np.square(DRIFT_PRIOR))
-        x[d] = 0.0
+        d = self.n_band
+        restart(self.x, self.P, [d, d + 1], np.diag(np.square(DRIFT_PRIOR)))
         if self.tilt is not None:           # the attitude restarts on the fix as well
-            i = self.n_band + 2
-            p[i, :] = 0.0
-            p[:, i] = 0.0
-            p[i, i] = self.tilt.prior ** 2
-            x[i] = 0.0
+            restart(self.x, self.P, [d + 2], np.diag([self.tilt.prior ** 2]))
         self.fixes = 0
 
     # ---- state -------------------------------------------------------------------------------
