@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy import signal
 
-from ..estimators.gnss_fusion import FusionParams, fuse
+from ..estimators.gnss_fusion import COAST_AFTER, FusionParams, fuse
 from ..sea.motion_model import VesselMotionParams, simulate_record, stack
 from ..sea.vessel import preset_raos, save_rao_csv
 
@@ -232,6 +232,13 @@ DROPOUTS = tuple((s, seed) for s in (270.0, 300.0, 320.0) for seed in range(1, 1
     tuple((400.0, seed) for seed in range(11, 21)) + tuple((350.0, seed) for seed in range(21, 41))
 
 
+#: The same (start + 900 s, seed): 19.5-21.7 min into a run, when the coast's spectrum window has
+#: grown to its longest (:data:`~marinefmu.estimators.heave.WINDOW_MAX`, 1200 s), as it has
+#: on a vessel that has been on station for a while; the dropouts above come 4.5-6.7 min into
+#: a run, with a spectrum from at most 400 s of data.
+LATE_DROPOUTS = tuple((start + 900.0, seed) for start, seed in DROPOUTS)
+
+
 #: Five-minute dropouts (start [s], seed), bridged by the wave coast (README): at 270 s of seeds 1-4.
 LONG_DROPOUTS = tuple((270.0, seed) for seed in range(1, 5))
 
@@ -248,21 +255,34 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
     coast) for each (start, seed) of ``cases``: the largest error per axis [m] in the gap.
 
     Returns ``cases`` (start, seed, max_error_m N/E/D), ``over_goal`` (cases with an axis at or
-    over ``goal`` m), ``worst_m`` per axis and ``mean_m`` per axis (of the per-case maxima).
-    Prints one line per case as it goes (about 5 s each).
+    over ``goal`` m), ``worst_m`` per axis and ``mean_m`` per axis (of the per-case maxima), and
+    ``pos_std``: how well the output's ``pos_std`` tells the error once the coast's pseudo-fixes
+    have started (:data:`~marinefmu.estimators.gnss_fusion.COAST_AFTER` s into the gap), over
+    all cases per axis — ``rms_z`` (RMS of error / ``pos_std``; 1 is calibrated, below 1
+    cautious), ``beyond_2`` and ``beyond_3`` (fractions of the time |z| > 2 and > 3; 4.6 % and
+    0.27 % for a Gaussian), ``mean_std_m`` and ``rms_error_m``. Prints one line per case as it
+    goes (about 5 s each, 20 s at :data:`LATE_DROPOUTS`).
     """
-    rows = []
+    rows, err_all, std_all = [], [], []
     for i, (start, seed) in enumerate(cases):
         rec = dropout_record(start, seed, duration)
         r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(), gnss_valid=rec["gnss_valid"])
         gap = slice(int(round(start / DT)), int(round((start + duration) / DT)))
         err = np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0)
+        coasted = slice(int(round((start + COAST_AFTER) / DT)), gap.stop)
+        err_all.append(r["pos"][coasted] - rec["cog"][coasted])
+        std_all.append(r["pos_std"][coasted])
         rows.append({"start": start, "seed": seed, "max_error_m": err.tolist()})
         print(f"dropout {i + 1}/{len(cases)} at {start:g} s, seed {seed}: max N / E / D "
               f"{' / '.join(f'{100 * e:.1f}' for e in err)} cm", flush=True)
     e = np.array([row["max_error_m"] for row in rows])
+    err_all, std_all = np.concatenate(err_all), np.concatenate(std_all)
+    z = np.abs(err_all) / std_all
+    calibration = {"rms_z": np.sqrt(np.mean(z**2, axis=0)).tolist(), "beyond_2": np.mean(z > 2.0, axis=0).tolist(),
+                   "beyond_3": np.mean(z > 3.0, axis=0).tolist(), "mean_std_m": std_all.mean(axis=0).tolist(),
+                   "rms_error_m": np.sqrt(np.mean(err_all**2, axis=0)).tolist()}
     return {"cases": rows, "duration_s": duration, "goal_m": goal, "over_goal": int(np.sum(np.any(e >= goal, axis=1))),
-            "worst_m": e.max(axis=0).tolist(), "mean_m": e.mean(axis=0).tolist()}
+            "worst_m": e.max(axis=0).tolist(), "mean_m": e.mean(axis=0).tolist(), "pos_std": calibration}
 
 
 def faults(duration: float = 360.0, start: float = 300.0) -> dict:
