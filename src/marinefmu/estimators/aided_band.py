@@ -98,7 +98,12 @@ What is left on east is at the wave frequency: through seed 27's gap the error s
 at the 8 s peak period on a ±1.5 m sway (±4 cm with the true attitude; before the spectrum
 settings). What tells the sway
 in a gap beyond the acceleration is the roll the gyro measures
-(:mod:`marinefmu.examples.gap_bound`); this filter does not use it. Measured and not taken
+(:mod:`marinefmu.examples.gap_bound`); this filter does not use it. Split by input (the filter
+replayed with one input real and the others true, 2026-11-24, README): the true tilt that the
+tilt states must follow through the gap is the largest part on seeds 3 and 10 (2.6 cm RMS),
+and with every input true the tilt states cost 1.3 → 3.0 cm RMS on seed 27: in a gap they
+follow ε with a bandwidth of about 0.37 rad/s, so what the band model misses at the wave peak
+partly lands in ε. Measured and not taken
 before the tilt states: lower offset noise, an offset-rate state, another offset noise in gaps
 only, a smoothed spectrum, and the fixes' attitude as a measurement of the offset itself
 (README, paper 001).

@@ -62,11 +62,11 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    standard deviation combined with the running RMS of the pseudo-fix innovations (how far the
    output strays from the coast between pseudo-fixes, :data:`TRACK_WEIGHT`), not the filter's:
    the filter takes the pseudo-fixes as independent and its covariance settles near 6.5 cm
-   whatever the error. Over the 60 dropouts of :mod:`.aided_band` (a scan, 2026-11-24), error
-   over ``pos_std`` in the gap: RMS 0.52 / 0.87 / 0.83 N / E / D, beyond 2 in 0 / 2.2 / 1.7 %
-   of the time (Gaussian: 4.6 %); with the filter's covariance plus the coast's, as until then,
-   0.12 / 0.40 / 0.22 and never (mean ``pos_std`` 6.4 / 6.9 / 6.5 cm on RMS errors of
-   0.8 / 2.7 / 1.4 cm). Without a coast
+   whatever the error. Over the 60 dropouts of :mod:`.aided_band` (``make bench``, part
+   ``dropout``, 2026-11-24), error over ``pos_std`` in the gap: RMS 0.52 / 0.90 / 0.85 N / E / D,
+   beyond 2 in 0.0 / 2.5 / 1.8 % of the time (Gaussian: 4.6 %); with the filter's covariance
+   plus the coast's, as until then, 0.12 / 0.40 / 0.22 and never (a scan; mean ``pos_std``
+   6.4 / 6.9 / 6.5 cm on RMS errors of 0.8 / 2.7 / 1.4 cm). Without a coast
    position for ``max_coast`` s (``"inertial"``, or a gap in the coast's first 3 minutes) the
    filter holds its position (velocity zero) until GNSS returns. Measured on the paper's
    set-up (1 Hz, 30 s dropout, seeds 1-3): see the README.
