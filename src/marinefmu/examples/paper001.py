@@ -285,6 +285,62 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
             "worst_m": e.max(axis=0).tolist(), "mean_m": e.mean(axis=0).tolist(), "pos_std": calibration}
 
 
+def dropout_trace(start: float = 350.0, seed: int = 27, duration: float = 30.0, out: str | Path | None = None) -> dict:
+    """One GNSS dropout (1 Hz RTK) traced: the fused COG's error per axis in real time, with its
+    ``pos_std``, and RTS-smoothed, from 20 s before the gap to 10 s after it. The default is the
+    hardest of :data:`DROPOUTS` (seed 27 at 350 s, README).
+
+    Returns ``max_error_m`` (real time) and ``max_error_smoothed_m`` per axis in the gap [m],
+    and ``max_z`` per axis: the largest |error| / ``pos_std`` in the gap once the coast's
+    pseudo-fixes have started. With ``out`` the plot ``paper001_dropout.png`` is written there.
+    """
+    rec = dropout_record(start, seed, duration)
+    r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(), gnss_valid=rec["gnss_valid"],
+             smooth=True)
+    gap = slice(int(round(start / DT)), int(round((start + duration) / DT)))
+    coasted = slice(int(round((start + COAST_AFTER) / DT)), gap.stop)
+    err, err_s = r["pos"] - rec["cog"], r["pos_smooth"] - rec["cog"]
+    result = {"max_error_m": np.max(np.abs(err[gap]), axis=0), "max_error_smoothed_m": np.max(np.abs(err_s[gap]), axis=0),
+              "max_z": np.max(np.abs(err[coasted]) / r["pos_std"][coasted], axis=0)}
+    if out is not None:
+        _plot_dropout(err, err_s, r["pos_std"], start, seed, duration, result, Path(out))
+    return result
+
+
+def _plot_dropout(err: np.ndarray, err_s: np.ndarray, std: np.ndarray, start: float, seed: int, duration: float,
+                  result: dict, out: Path) -> None:
+    """Error per axis through the dropout, real time with ±2 ``pos_std`` and RTS-smoothed."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out.mkdir(parents=True, exist_ok=True)
+    t = (np.arange(len(err)) + 1) * DT
+    w = t >= start - 20.0
+    fig, ax = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
+    for i, name in enumerate(("north", "east", "down")):
+        a = ax[i]
+        a.axvspan(start, start + duration, color="0.92", label="GNSS dropout")
+        a.fill_between(t[w], -200 * std[w, i], 200 * std[w, i], color="tab:blue", alpha=0.15, label="±2 pos_std")
+        a.plot(t[w], 100 * err[w, i], color="tab:blue", lw=1,
+               label=f"real time (max in gap {100 * result['max_error_m'][i]:.1f} cm)")
+        a.plot(t[w], 100 * err_s[w, i], "--", color="tab:green", lw=1,
+               label=f"RTS-smoothed ({100 * result['max_error_smoothed_m'][i]:.1f} cm)")
+        for goal in (-10.0, 10.0):
+            a.axhline(goal, color="tab:red", lw=0.8, ls=":")
+        a.set_ylabel(f"{name} error [cm]")
+        a.set_ylim(-20.0, 20.0)
+        a.grid(alpha=0.3)
+        a.legend(loc="lower left", fontsize=7, ncol=2)
+    ax[-1].set_xlabel("time [s]")
+    fig.suptitle(f"Paper 001 set-up, 1 Hz RTK: COG error through a {duration:g} s GNSS dropout at {start:g} s "
+                 f"(seed {seed}); dotted: the issue's 10 cm", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out / "paper001_dropout.png", dpi=100)
+    plt.close(fig)
+
+
 def faults(duration: float = 360.0, start: float = 300.0) -> dict:
     """A 20 m GNSS jump lasting 10 s, and a 30 s dropout, both at ``start`` s, 1 Hz GNSS.
     Returns the largest deviation [m] of the fused COG from the fault-free run during the jump

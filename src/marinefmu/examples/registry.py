@@ -47,6 +47,15 @@ def _faults(out: Path) -> dict:
     return paper001.faults()
 
 
+def _dropout(out: Path) -> dict:
+    from . import paper001
+
+    r = paper001.dropout_trace(out=out)
+    return {"max error in the gap N/E/D, real time [cm]": 100 * r["max_error_m"],
+            "max error in the gap N/E/D, RTS-smoothed [cm]": 100 * r["max_error_smoothed_m"],
+            "largest error / pos_std N/E/D": r["max_z"]}
+
+
 def _cr_convergence(out: Path) -> dict:
     from . import paper002
 
@@ -96,6 +105,8 @@ EXAMPLES: dict[str, tuple[str, Callable[[Path], dict]]] = {
     "paper001-tilting": ("Paper 001 Fig. 11: errors with and without attitude correction", _tilting),
     "paper001-buoy": ("Paper 001 §4.3: buoy-like case, vertical error from attitude", _buoy),
     "paper001-faults": ("Paper 001 robustness: 20 m GNSS jump and 30 s dropout at 1 Hz", _faults),
+    "paper001-dropout": ("Paper 001: COG error through the hardest 30 s GNSS dropout at 1 Hz (seed 27), real time "
+                         "with ±2 pos_std and RTS-smoothed (plot)", _dropout),
     "paper002-convergence": ("Paper 002: CR of two sensors against known truth (10 min, MEMS noise)", _cr_convergence),
     "paper002-weak-translation": ("Paper 002: CR with weak translations (small floor), against truth", _cr_weak),
     "paper002-angle-errors": ("Paper 002's z discrepancy: CR shift from roll/pitch errors and the high-pass angles (plot)", _cr_angles),
