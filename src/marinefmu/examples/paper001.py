@@ -250,6 +250,13 @@ def dropout_record(start: float, seed: int, duration: float = 30.0) -> dict[str,
                                               "gnss.dropout.duration": duration, "sea.seed": seed, "sensors.seed": seed})
 
 
+def gap_slices(start: float, duration: float) -> tuple[slice, slice]:
+    """Sample slices of a record (:func:`dropout_record`) for the gap, and for its part from the
+    coast's first pseudo-fix on (:data:`~marinefmu.estimators.gnss_fusion.COAST_AFTER` s in)."""
+    gap = slice(int(round(start / DT)), int(round((start + duration) / DT)))
+    return gap, slice(int(round((start + COAST_AFTER) / DT)), gap.stop)
+
+
 def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict:
     """The fused real-time COG through a ``duration`` s GNSS dropout (1 Hz RTK, wave-model
     coast) for each (start, seed) of ``cases``: the largest error per axis [m] in the gap.
@@ -267,9 +274,8 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
     for i, (start, seed) in enumerate(cases):
         rec = dropout_record(start, seed, duration)
         r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(), gnss_valid=rec["gnss_valid"])
-        gap = slice(int(round(start / DT)), int(round((start + duration) / DT)))
+        gap, coasted = gap_slices(start, duration)
         err = np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0)
-        coasted = slice(int(round((start + COAST_AFTER) / DT)), gap.stop)
         err_all.append(r["pos"][coasted] - rec["cog"][coasted])
         std_all.append(r["pos_std"][coasted])
         rows.append({"start": start, "seed": seed, "max_error_m": err.tolist()})
@@ -297,8 +303,7 @@ def dropout_trace(start: float = 350.0, seed: int = 27, duration: float = 30.0, 
     rec = dropout_record(start, seed, duration)
     r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(), gnss_valid=rec["gnss_valid"],
              smooth=True)
-    gap = slice(int(round(start / DT)), int(round((start + duration) / DT)))
-    coasted = slice(int(round((start + COAST_AFTER) / DT)), gap.stop)
+    gap, coasted = gap_slices(start, duration)
     err, err_s = r["pos"] - rec["cog"], r["pos_smooth"] - rec["cog"]
     result = {"max_error_m": np.max(np.abs(err[gap]), axis=0), "max_error_smoothed_m": np.max(np.abs(err_s[gap]), axis=0),
               "max_z": np.max(np.abs(err[coasted]) / r["pos_std"][coasted], axis=0)}
