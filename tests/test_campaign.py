@@ -172,6 +172,32 @@ def test_a_local_cluster_runs_the_grid_records_a_failure_and_resumes(spec_file, 
     assert (retried.ran, retried.failed) == (2, 2)                   # the failing pair fails again
 
 
+@pytest.mark.isolated(timeout=600)
+def test_ctrl_c_between_a_runs_log_line_and_the_table_rewrite_keeps_them_equal(spec_file, tmp_path, fmu_dir,
+                                                                                 monkeypatch):
+    """Ctrl-C right after the first run's line reached ``runs.jsonl``, before ``results.csv``
+    was rewritten (seen once in CI: the interrupted CLI said 1 run was in the table, which had
+    none). The table follows the log again before the interrupt goes on."""
+    from marinefmu.campaign import engine
+
+    calls = []
+    real = engine.write_table
+
+    def interrupted_rewrite(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:                  # the rewrite after the first finished run
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(engine, "write_table", interrupted_rewrite)
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt):
+        run_campaign(load_spec(spec_file, fmu_dir), out, workers=1, progress=False)
+    logged = [json.loads(line)["id"] for line in (out / LOG_NAME).read_text().splitlines()]
+    assert len(logged) == 1 and len(calls) == 3
+    assert [r["id"] for r in read_table(out / "results.csv")] == logged
+
+
 def test_an_unreachable_scheduler_fails_fast_naming_it(spec_file, tmp_path, fmu_dir, monkeypatch):
     import time
 
