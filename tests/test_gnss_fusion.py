@@ -103,6 +103,7 @@ def test_bad_epochs_are_skipped_with_a_reason_and_the_filter_coasts(positions, r
     ({"gyro_bias_tau": 0.0}, r"gyro_bias_tau = 0.0 is out of range"),
     ({"antenna_sigma_h": -0.01}, r"antenna_sigma_h = -0.01 is out of range"),
     ({"antenna_sigma_v": 0.0}, r"antenna_sigma_v = 0.0 is out of range"),
+    ({"acc_noise": 0.0}, r"acc_noise = 0.0 is out of range"), ({"gyro_noise": 2.0}, r"gyro_noise = 2.0 is out of range"),
 ])
 def test_invalid_settings_are_refused_by_name(kwargs, match):
     with pytest.raises(ParameterError, match=match):

@@ -124,6 +124,8 @@ FUSION_PARAMETERS: list[Variable] = [
     real("gyro_bias_tau", _FU.gyro_bias_tau, "s", "Gyro bias correlation time for the tilt states, 0.1..1e6"),
     real("antenna_sigma_h", _FU.antenna_sigma_h, "m", "Horizontal noise of one antenna position (the fix attitude's weight in the tilt states), (0, 100]"),
     real("antenna_sigma_v", _FU.antenna_sigma_v, "m", "Vertical noise of one antenna position, (0, 100]"),
+    real("acc_noise", _FU.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, for pos_std only (the filter blends with q), (0, 10]"),
+    real("gyro_noise", _FU.gyro_noise, "rad/s/sqrt(Hz)", "Gyro white-noise density (angle random walk), for pos_std only, (0, 1]"),
 ]
 FUSION_INPUTS: list[Variable] = [
     *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),
@@ -135,7 +137,7 @@ FUSION_INPUTS: list[Variable] = [
 FUSION_OUTPUTS: list[Variable] = [
     *vec("pos", "ned", 0.0, "m", "Fused COG position, NED"),
     *vec("vel", "ned", 0.0, "m/s", "Fused COG velocity, NED"),
-    *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (filter covariance; in a gap the wave coast's own plus the output's spread about it), NED"),
+    *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (the error covariance of the filter as run, with the sensor noises; in a gap the wave coast's own plus the output's spread about it), NED"),
     real("roll", 0.0, "rad", "Roll used for the correction (antennas, gyro-propagated)"),
     real("pitch", 0.0, "rad", "Pitch used for the correction"),
     real("yaw", 0.0, "rad", "Yaw used for the correction"),
@@ -161,6 +163,7 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
         coast=v["coast"], coast_sigma=v["coast_sigma"], coast_attitude_tau=v["coast_attitude_tau"],
         coast_window=v["coast_window"], coast_tilt=bool(v["coast_tilt"]), gyro_bias_sigma=v["gyro_bias_sigma"],
         gyro_bias_tau=v["gyro_bias_tau"], antenna_sigma_h=v["antenna_sigma_h"], antenna_sigma_v=v["antenna_sigma_v"],
+        acc_noise=v["acc_noise"], gyro_noise=v["gyro_noise"],
     )
 
 

@@ -66,7 +66,9 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    ``dropout``, 2026-11-24), error over ``pos_std`` in the gap: RMS 0.52 / 0.90 / 0.85 N / E / D,
    beyond 2 in 0.0 / 2.5 / 1.8 % of the time (Gaussian: 4.6 %); with the filter's covariance
    plus the coast's, as until then, 0.12 / 0.40 / 0.22 and never (a scan; mean ``pos_std``
-   6.4 / 6.9 / 6.5 cm on RMS errors of 0.8 / 2.7 / 1.4 cm). Without a coast
+   6.4 / 6.9 / 6.5 cm on RMS errors of 0.8 / 2.7 / 1.4 cm). Between fixes ``pos_std`` is not
+   the filter's covariance either, whose q and r set the blend but not the size of the errors,
+   but that of the error the filter makes as it runs (:mod:`.fusion_error`). Without a coast
    position for ``max_coast`` s (``"inertial"``, or a gap in the coast's first 3 minutes) the
    filter holds its position (velocity zero) until GNSS returns. Measured on the paper's
    set-up (1 Hz, 30 s dropout, seeds 1-3): see the README.
@@ -85,6 +87,7 @@ from scipy.spatial.transform import Rotation
 from ..errors import ParameterError, ShapeError, check_choice, check_range, check_vector
 from ..frames import GRAVITY_N, cross3, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
 from .samples import force_beyond_limit, rate_beyond_limit
+from .fusion_error import FusionError
 from .wave_coast import WaveCoast
 
 log = logging.getLogger(__name__)
@@ -204,7 +207,16 @@ class FusionParams:
     antenna_sigma_h, antenna_sigma_v : float
         Standard deviation of one antenna position, horizontal and vertical [m], (0, 100]: the
         weight of a fix's attitude in the tilt states (:func:`antenna_attitude_std`; RTK 1 and
-        1.5 cm). [``antenna_sigma_h``, ``antenna_sigma_v``]
+        1.5 cm) and the fix noise of ``pos_std`` (:mod:`.fusion_error`). [``antenna_sigma_h``,
+        ``antenna_sigma_v``]
+    acc_noise : float
+        Accelerometer white-noise density [m/s²/√Hz], (0, 10] (VesselMotion's default MEMS
+        7e-4): the sensor's, for ``pos_std`` only (:mod:`.fusion_error`); the filter blends
+        with ``q``. [``acc_noise``]
+    gyro_noise : float
+        Gyro white-noise density (angle random walk) [rad/s/√Hz], (0, 1] (VesselMotion's
+        default 5e-5), for ``pos_std`` only, with ``gyro_bias_sigma`` and ``gyro_bias_tau``.
+        [``gyro_noise``]
     """
 
     antennas: tuple = DEFAULT_ANTENNAS
@@ -231,6 +243,8 @@ class FusionParams:
     gyro_bias_tau: float = 50.0
     antenna_sigma_h: float = 0.01
     antenna_sigma_v: float = 0.015
+    acc_noise: float = 7e-4
+    gyro_noise: float = 5e-5
     arms: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -266,6 +280,8 @@ class FusionParams:
         check_range("gyro_bias_tau", self.gyro_bias_tau, lo=0.1, hi=1e6, unit="s")
         check_range("antenna_sigma_h", self.antenna_sigma_h, lo=0.0, lo_open=True, hi=100.0, unit="m")
         check_range("antenna_sigma_v", self.antenna_sigma_v, lo=0.0, lo_open=True, hi=100.0, unit="m")
+        check_range("acc_noise", self.acc_noise, lo=0.0, lo_open=True, hi=10.0, unit="m/s2/sqrt(Hz)")
+        check_range("gyro_noise", self.gyro_noise, lo=0.0, lo_open=True, hi=1.0, unit="rad/s/sqrt(Hz)")
 
 
 @dataclass(frozen=True)
@@ -351,9 +367,10 @@ class FusionResult:
     pos, vel : tuple of float
         COG position [m] and velocity [m/s], NED.
     pos_std : tuple of float
-        1σ of the fused position [m]: the filter's covariance, or in a GNSS gap bridged by the
-        wave coast the coast's own and the output's spread about it (module docstring); 0
-        before initialisation.
+        1σ of the fused position [m]: the covariance of the error the filter makes as it runs,
+        with the sensors' noises (:mod:`.fusion_error`), or in a GNSS gap bridged by the wave
+        coast the coast's own and the output's spread about it (module docstring); 0 before
+        initialisation.
     euler : tuple of float
         Roll, pitch, yaw [rad] used for the correction.
     acc_n : tuple of float
@@ -499,6 +516,10 @@ class GnssAccFusion:
         self.since_pseudo = 0.0  # time since the last wave-model pseudo-fix [s]
         self.coast_var: np.ndarray | None = None  # coast position variance at the last pseudo-fix [m²]
         self.coast_track: np.ndarray | None = None  # mean square of the pseudo-fix innovations [m²]
+        # the covariance of the error as the filter runs, for pos_std outside gaps
+        self.error = FusionError(p.arms, p.acc_noise, p.gyro_noise, (p.antenna_sigma_h, p.antenna_sigma_v),
+                                 p.gyro_bias_sigma, p.gyro_bias_tau, p.attitude_tau if p.propagation == "gyro" else None)
+        self._q_true: tuple | None = None  # its process noise for _model_dt: acceleration, bias
 
     # ---- per step ----------------------------------------------------------------------------
     def step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None) -> FusionResult:
@@ -550,8 +571,12 @@ class GnssAccFusion:
             if dt != self._model_dt:  # rebuilt only when the step size changes
                 self.kf.F, self.kf.B = transition(dt, p.bias_states)
                 self.kf.Q = process_noise(dt, p.q, p.bias_rw if p.bias_states else None, p.q_down)
+                q_acc = process_noise(dt, self.error.q_true, p.bias_rw if p.bias_states else None)
+                self._q_true = (q_acc, np.zeros_like(q_acc))
+                self._q_true[1][6:, 6:], q_acc[6:, 6:] = q_acc[6:, 6:], 0.0
                 self._model_dt = dt
             self.kf.predict(u=u.reshape(3, 1))
+            self.error.predict(self.kf.F, *self._q_true)
             self.prior = (self.kf.x.copy(), self.kf.P.copy())
         if self.coaster is not None and self.initialised:
             self.coaster.add(quat_to_rot(self.q_coast) @ f_b + GRAVITY_N if self.coast_attitude else self.acc_n, dt)
@@ -604,6 +629,7 @@ class GnssAccFusion:
             # independent samples: its covariance goes back in before GNSS is weighed again
             self.kf.P[:3, :3] += np.diag(self.coast_var)
             self.coast_var = self.coast_track = None
+            self.error.follow(self.kf.P)
         y = z - self.kf.H @ self.kf.x.ravel()
         s = self.kf.H @ self.kf.P @ self.kf.H.T + r_meas
         d = math.sqrt(float(y @ np.linalg.solve(s, y)))
@@ -614,14 +640,17 @@ class GnssAccFusion:
                 return "accepted", f"GNSS fixes rejected for {p.reinit_time} s: filter re-initialised on GNSS"
             return "rejected", f"GNSS epoch rejected: innovation {d:.1f} sigma > gate {p.gate}"
         self.kf.update(z, R=r_meas)
+        since = min(self.since_fix, 1e9)
+        self.error.fix(y, self.kf.K, self.kf.H, since)
         if self.coaster is not None:
             self.coaster.anchor(z)
-        self._correct_attitude(sol.rot, min(self.since_fix, 1e9))
+        self._correct_attitude(sol.rot, since)
+        att_std = antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v)
+        self.error.attitude_fix(att_std, since)
         if self.coast_attitude:
             rot_c, bias_c = quat_to_rot(self.q_coast), self.coast_bias.copy()
             if self.coaster.tilt is not None:
-                self.coaster.attitude_fix(Rotation.from_matrix(sol.rot @ rot_c.T).as_rotvec(),
-                                          antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v))
+                self.coaster.attitude_fix(Rotation.from_matrix(sol.rot @ rot_c.T).as_rotvec(), att_std)
             self.q_coast, self.coast_bias = pi_pull(self.q_coast, self.coast_bias, sol.rot, min(self.since_fix, 1e9),
                                                     p.coast_attitude_tau)
             if self.coaster.tilt is not None:
@@ -654,6 +683,7 @@ class GnssAccFusion:
         y2 = (z - self.kf.H @ self.kf.x.ravel()) ** 2
         self.coast_track = y2 if self.coast_track is None else self.coast_track + TRACK_WEIGHT * (y2 - self.coast_track)
         self.kf.update(z, R=np.diag(self.params.coast_sigma ** 2 + self.coast_var))
+        self.error.follow(self.kf.P)
         self.since_pseudo = 0.0
         return True
 
@@ -673,6 +703,7 @@ class GnssAccFusion:
         self.prior = None  # a restart: nothing to smooth across
         self.kf.x = x
         self.kf.P = np.diag(var)
+        self.error.start(self.kf.P, antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v))
         self.q = Rotation.from_matrix(sol.rot).as_quat(scalar_first=True)
         self.q_coast = self.q.copy()
         self.coast_var = self.coast_track = None
@@ -697,8 +728,8 @@ class GnssAccFusion:
         vel = x[3:6].copy()
         if w is not None and self.initialised:
             vel -= rot @ cross3(w - self.gyro_bias, p.acc_lever_arm)
-        if self.coast_var is None:
-            var = np.diag(self.kf.P)[:3]
+        if self.coast_var is None:     # the error as the filter runs (fusion_error)
+            var = self.error.position_var(rot)
         else:   # in a gap: the coast's own, and how far the output strays from it (module docstring)
             var = self.coast_var + self.coast_track
         std = np.sqrt(var) if self.initialised else np.zeros(3)  # valid is False then
@@ -720,6 +751,7 @@ class GnssAccFusion:
             "coast_var": None if self.coast_var is None else self.coast_var.tolist(),
             "coast_track": None if self.coast_track is None else self.coast_track.tolist(),
             "coaster": None if self.coaster is None else self.coaster.get_state(),
+            "error": self.error.get_state(),
         }
 
     def set_state(self, s: dict) -> None:
@@ -738,6 +770,7 @@ class GnssAccFusion:
         self.coast_track = None if s.get("coast_track") is None else np.array(s["coast_track"])
         if self.coaster is not None:
             self.coaster.set_state(s["coaster"])
+        self.error.set_state(s["error"])
 
 
 def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyro: np.ndarray | None = None,

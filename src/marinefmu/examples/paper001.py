@@ -200,16 +200,25 @@ def tilting(rate: float = 1.0, duration: float = 600.0, settle: float = 60.0) ->
     return out
 
 
+def buoy_setup(height: float = 0.97, **kw) -> tuple[dict, FusionParams]:
+    """Experiment (c)'s set-up: the VesselMotion settings (small hull, Hs 2 m, Tp 6 s, the IMU at
+    the antennas' height) and the FusionParams (four antennas in a 1 m square ``height`` m above
+    the COG; ``kw`` changes more)."""
+    ant = ((0.5, -0.5, -height), (0.5, 0.5, -height), (-0.5, -0.5, -height), (-0.5, 0.5, -height))
+    extra = {"vessel.preset": "research36", "sea.hs": 2.0, "sea.tp": 6.0, "imu.x": 0.0, "imu.y": 0.0, "imu.z": -height}
+    for i, a in enumerate(ant):
+        extra.update({f"gnss.ant{i + 1}.x": a[0], f"gnss.ant{i + 1}.y": a[1], f"gnss.ant{i + 1}.z": a[2]})
+    return extra, FusionParams(antennas=ant, acc_lever_arm=(0.0, 0.0, -height), **kw)
+
+
 def buoy(duration: float = 600.0, settle: float = 60.0, height: float = 0.97) -> dict:
     """Experiment (c): small hull (research36) in beam seas, four antennas in a 1 m square
     ``height`` m above the COG at the waterline. Vertical RMS error [m] of the antenna
     centroid's elevation taken as the buoy's (no attitude correction: the tilt drops the
     antennas by h(1 − cos θ) and swings them), of the fix's COG (antenna attitude applied),
     and of the fused COG."""
-    ant = ((0.5, -0.5, -height), (0.5, 0.5, -height), (-0.5, -0.5, -height), (-0.5, 0.5, -height))
-    extra = {"vessel.preset": "research36", "sea.hs": 2.0, "sea.tp": 6.0, "imu.x": 0.0, "imu.y": 0.0, "imu.z": -height}
-    for i, a in enumerate(ant):
-        extra.update({f"gnss.ant{i + 1}.x": a[0], f"gnss.ant{i + 1}.y": a[1], f"gnss.ant{i + 1}.z": a[2]})
+    extra, fusion = buoy_setup(height)
+    ant = fusion.antennas
     rec = simulate(duration, extra)
     new = rec["gnss_new"]
     s = np.arange(len(new)) >= int(settle / DT)
@@ -217,8 +226,7 @@ def buoy(duration: float = 600.0, settle: float = 60.0, height: float = 0.97) ->
     from ..estimators.gnss_fusion import antenna_attitude
 
     fix_d = np.array([antenna_attitude(g, np.array(ant)).cog[2] for g in rec["gnss"][new & s]])
-    r = fuse(rec["acc"], DT, rec["gnss"], new, rec["gyro"],
-             replace(FusionParams(antennas=ant, acc_lever_arm=(0.0, 0.0, -height))))
+    r = fuse(rec["acc"], DT, rec["gnss"], new, rec["gyro"], fusion)
     err = lambda e: float(np.sqrt(np.mean(e ** 2)))  # noqa: E731
     return {"uncorrected": err(cen[new & s] - rec["cog"][new & s, 2]), "fix": err(fix_d - rec["cog"][new & s, 2]),
             "fused": err(r["pos"][s, 2] - rec["cog"][s, 2]), "roll_std_deg": float(np.degrees(rec["euler"][s, 0].std()))}
@@ -282,13 +290,65 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
         print(f"dropout {i + 1}/{len(cases)} at {start:g} s, seed {seed}: max N / E / D "
               f"{' / '.join(f'{100 * e:.1f}' for e in err)} cm", flush=True)
     e = np.array([row["max_error_m"] for row in rows])
-    err_all, std_all = np.concatenate(err_all), np.concatenate(std_all)
-    z = np.abs(err_all) / std_all
-    calibration = {"rms_z": np.sqrt(np.mean(z**2, axis=0)).tolist(), "beyond_2": np.mean(z > 2.0, axis=0).tolist(),
-                   "beyond_3": np.mean(z > 3.0, axis=0).tolist(), "mean_std_m": std_all.mean(axis=0).tolist(),
-                   "rms_error_m": np.sqrt(np.mean(err_all**2, axis=0)).tolist()}
     return {"cases": rows, "duration_s": duration, "goal_m": goal, "over_goal": int(np.sum(np.any(e >= goal, axis=1))),
-            "worst_m": e.max(axis=0).tolist(), "mean_m": e.mean(axis=0).tolist(), "pos_std": calibration}
+            "worst_m": e.max(axis=0).tolist(), "mean_m": e.mean(axis=0).tolist(),
+            "pos_std": calibration(np.concatenate(err_all), np.concatenate(std_all))}
+
+
+def calibration(err: np.ndarray, std: np.ndarray) -> dict:
+    """How well a standard deviation ``std`` tells the error ``err`` [m] ((N, 3) each), per axis:
+    ``rms_z`` (RMS of error / std; 1 is calibrated, below 1 cautious), ``beyond_2`` and
+    ``beyond_3`` (fractions of the samples with |z| > 2 and > 3; 4.6 % and 0.27 % for a
+    Gaussian), ``mean_std_m`` and ``rms_error_m``."""
+    z = np.abs(err) / std
+    return {"rms_z": np.sqrt(np.mean(z**2, axis=0)).tolist(), "beyond_2": np.mean(z > 2.0, axis=0).tolist(),
+            "beyond_3": np.mean(z > 3.0, axis=0).tolist(), "mean_std_m": std.mean(axis=0).tolist(),
+            "rms_error_m": np.sqrt(np.mean(err**2, axis=0)).tolist()}
+
+
+#: Runs of :func:`pos_std_between_fixes`: name → (GNSS rate [Hz], seeds, FusionParams changes,
+#: set-up: ``"tilting"`` the paper-001 set-up of experiment (b), ``"buoy"`` experiment (c)).
+POS_STD_CASES = {
+    "1 Hz": (1.0, tuple(range(1, 11)), {}, "tilting"),
+    "10 Hz": (10.0, (1, 2, 3), {}, "tilting"),
+    "uncorrected, 1 Hz": (1.0, (1, 2, 3), {"attitude_correction": False, "gate": math.inf}, "tilting"),
+    "buoy, 1 Hz": (1.0, (1, 2, 3), {}, "buoy"),
+}
+
+
+def pos_std_run(rate: float, seed: int, kw: dict | None = None, setup: str = "tilting", duration: float = 300.0,
+                settle: float = 100.0) -> dict:
+    """One run without a GNSS gap (sea and sensor ``seed``): :func:`calibration` of the fused
+    output's ``pos_std`` after ``settle`` s, plus ``fix``: the fraction of GNSS epochs accepted."""
+    if setup == "buoy":
+        extra, fusion = buoy_setup(**(kw or {}))
+    else:
+        extra, fusion = {}, params(**(kw or {}))
+    rec = simulate(duration, {**extra, "gnss.rate": rate, "sea.seed": seed, "sensors.seed": seed})
+    r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], fusion, gnss_valid=rec["gnss_valid"])
+    s = slice(int(round(settle / DT)), None)
+    epochs = r["fix"][rec["gnss_new"]]
+    return {**calibration(r["pos"][s] - rec["cog"][s], r["pos_std"][s]),
+            "fix": float(np.mean(epochs == "accepted"))}
+
+
+def pos_std_between_fixes(cases: dict = POS_STD_CASES) -> dict:
+    """``pos_std`` against the error away from GNSS gaps (:mod:`~marinefmu.estimators.fusion_error`):
+    per case of ``cases`` the ``rms_z`` of each seed and the largest of them per axis
+    (``worst_rms_z``), the smallest (``least_rms_z``) and the mean ``beyond_2`` over the seeds.
+    About 5 s a run; prints a line per run."""
+    out = {}
+    for name, (rate, seeds, kw, setup) in cases.items():
+        runs = []
+        for seed in seeds:
+            runs.append(pos_std_run(rate, seed, kw, setup))
+            print(f"pos_std {name}, seed {seed}: error / pos_std RMS "
+                  f"{' / '.join(f'{v:.2f}' for v in runs[-1]['rms_z'])}", flush=True)
+        z = np.array([r["rms_z"] for r in runs])
+        out[name] = {"seeds": list(seeds), "runs": runs, "worst_rms_z": z.max(axis=0).tolist(),
+                     "least_rms_z": z.min(axis=0).tolist(),
+                     "beyond_2": np.mean([r["beyond_2"] for r in runs], axis=0).tolist()}
+    return out
 
 
 def dropout_trace(start: float = 350.0, seed: int = 27, duration: float = 30.0, out: str | Path | None = None) -> dict:
