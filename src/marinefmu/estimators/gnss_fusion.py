@@ -571,9 +571,10 @@ class GnssAccFusion:
             if dt != self._model_dt:  # rebuilt only when the step size changes
                 self.kf.F, self.kf.B = transition(dt, p.bias_states)
                 self.kf.Q = process_noise(dt, p.q, p.bias_rw if p.bias_states else None, p.q_down)
-                q_acc = process_noise(dt, self.error.q_true, p.bias_rw if p.bias_states else None)
-                self._q_true = (q_acc, np.zeros_like(q_acc))
-                self._q_true[1][6:, 6:], q_acc[6:, 6:] = q_acc[6:, 6:], 0.0
+                full = process_noise(dt, self.error.q_true, p.bias_rw if p.bias_states else None)
+                acc_part = np.zeros_like(full)
+                acc_part[:6, :6] = full[:6, :6]
+                self._q_true = (acc_part, full - acc_part)
                 self._model_dt = dt
             self.kf.predict(u=u.reshape(3, 1))
             self.error.predict(self.kf.F, *self._q_true)
@@ -860,7 +861,8 @@ def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarr
         (N,) bool, True where a new fix arrived.
     params : FusionParams, optional
         ``q``, ``q_down``, ``r``, ``gate``, ``bias_states`` … (its antennas, lever arm,
-        attitude correction and propagation are overridden as above).
+        attitude correction and propagation are overridden as above). ``antenna_sigma_h`` and
+        ``antenna_sigma_v`` are the receiver's noise, for ``pos_std``.
 
     Returns
     -------
@@ -869,7 +871,12 @@ def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarr
     """
     from dataclasses import replace
 
-    p = replace(params or FusionParams(), attitude_correction=False, propagation="hold", acc_lever_arm=(0.0, 0.0, 0.0))
+    p = params or FusionParams()
+    # centred virtual antennas: the attitude is exact and has no share in pos_std; they carry the
+    # receiver's one error, so the centroid's noise is the receiver's (fusion_error: σ²/4)
+    p = replace(p, attitude_correction=False, propagation="hold", acc_lever_arm=(0.0, 0.0, 0.0),
+                antennas=tuple(tuple(a) for a in (p.arms - p.arms.mean(axis=0)).tolist()),
+                antenna_sigma_h=2.0 * p.antenna_sigma_h, antenna_sigma_v=2.0 * p.antenna_sigma_v)
     pos = np.asarray(pos, dtype=float)
     if pos.ndim != 2 or pos.shape[1] != 3:
         raise ShapeError(f"expected pos (N, 3); got {pos.shape}")
