@@ -61,6 +61,15 @@ MAX_Q_SCALE = 1e8
 LOOP_SUBSTEP = 0.1
 
 
+def pi_gains(interval: float, tau: float) -> tuple[float, float]:
+    """Gains of the PI attitude loop (:func:`~.gnss_fusion.pi_pull`) for a fix ``interval`` s
+    after the previous one, time constant ``tau`` [s]: the proportional fraction k_p·Δt with
+    k_p = 2/τ, at most 1, and the integral gain k_i·Δt = Δt/τ², capped at 1/Δt after a gap
+    longer than τ: e/Δt is then the whole bias error that built the attitude error e (after a
+    300 s gap at τ = 30 s the uncapped gain would correct it 100 times over)."""
+    return min(1.0, 2.0 * interval / tau), interval / max(tau, interval) ** 2
+
+
 def skew(r: np.ndarray) -> np.ndarray:
     """[r]×, the cross-product matrix: skew(r) @ v = r × v."""
     return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
@@ -165,21 +174,33 @@ class FusionError:
         ikh = np.eye(len(self.P)) - k @ h
         self.P = ikh @ self.P @ ikh.T + (k * self.r_true) @ k.T
 
-    def attitude_fix(self, fix_attitude_std: np.ndarray, interval: float) -> None:
+    def _prior(self, interval: float) -> np.ndarray:
+        """(3, 3, 3) covariance of the loop's error states ``interval`` s after the last pull."""
+        a, q = loop_interval(round(interval, 6), self.gyro_noise, self.bias_sigma, self.bias_tau)
+        return a @ self.loop @ a.T + q              # broadcast over the three axes
+
+    def attitude_gain(self, fix_attitude_std: np.ndarray, interval: float) -> np.ndarray:
+        """(3,) one-step Kalman gain per NED axis of a fix attitude of standard deviations
+        ``fix_attitude_std`` [rad] ``interval`` s after the last pull: P_ε⁻/(P_ε⁻ + σ²)."""
+        prior = self._prior(interval)[:, 0, 0]
+        return prior / (prior + np.square(fix_attitude_std))
+
+    def attitude_fix(self, fix_attitude_std: np.ndarray, interval: float, alpha: np.ndarray | None = None) -> None:
         """The attitude was pulled towards a fix whose attitude has standard deviations
-        ``fix_attitude_std`` [rad, NED], ``interval`` s after the previous pull."""
+        ``fix_attitude_std`` [rad, NED], ``interval`` s after the previous pull, with the
+        proportional gains ``alpha`` per axis (None: the PI's, :func:`pi_gains`)."""
         s2 = np.square(fix_attitude_std)
         if self.attitude_tau is None:               # held: the fix's attitude itself
             self.eps_var = s2.copy()
             return
-        a, q = loop_interval(round(interval, 6), self.gyro_noise, self.bias_sigma, self.bias_tau)
-        prior = a @ self.loop @ a.T + q             # broadcast over the three axes
-        tau = self.attitude_tau
-        alpha = min(1.0, 2.0 * interval / tau)      # pi_pull: k_p, and k_i capped after a gap
-        k_i = interval / max(tau, interval) ** 2
-        u = np.array([[1.0 - alpha, 0.0, 0.0], [k_i, 1.0, 0.0], [0.0, 0.0, 1.0]])
-        v = np.array([-alpha, k_i, 0.0])
-        self.loop = u @ prior @ u.T + s2[:, None, None] * np.outer(v, v)
+        prior = self._prior(interval)
+        k_p, k_i = pi_gains(interval, self.attitude_tau)
+        alpha = np.broadcast_to(k_p if alpha is None else alpha, (3,))
+        u = np.zeros((3, 3, 3))
+        u[:, 0, 0], u[:, 1, 0], u[:, 1, 1], u[:, 2, 2] = 1.0 - alpha, k_i, 1.0, 1.0
+        v = np.zeros((3, 3))
+        v[:, 0], v[:, 1] = -alpha, k_i
+        self.loop = u @ prior @ u.transpose(0, 2, 1) + s2[:, None, None] * v[:, :, None] * v[:, None, :]
         self.eps_var = 0.5 * (prior[:, 0, 0] + self.loop[:, 0, 0])
 
     def position_var(self, rot: np.ndarray) -> np.ndarray:
