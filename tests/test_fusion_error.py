@@ -80,7 +80,7 @@ def test_pos_std_between_fixes_tells_the_error(case):
     ``paper001.POS_STD_CASES`` (1 Hz and 10 Hz on the paper-001 set-up, the uncorrected
     acceleration, the buoy). Measured RMS 0.76 / 0.73 / 0.99 (1 Hz), 0.80 / 0.72 / 1.01
     (10 Hz), 0.84 / 1.05 / 1.27 uncorrected (east off by g·sin(roll), 14.5 cm RMS: without the
-    consistency check 14 there), 0.71 / 0.63 / 0.99 the buoy. Bounds RMS 0.55-1.3 and beyond 2
+    consistency check 14 there), 0.66 / 0.61 / 0.99 the buoy. Bounds RMS 0.55-1.3 and beyond 2
     at most 10 % of the time (Gaussian 4.6 %): the error is correlated over seconds to tens of
     seconds, so 200 s hold some twenty independent samples, and the fraction beyond 2 of twenty
     scatters by ±4.7 %. Until 2026-11-24 ``pos_std`` was the filter's own covariance, 3-8.5 cm

@@ -34,11 +34,11 @@ the filter, without changing the fused output:
    innovations, and the covariance follows. The attitude's share cancels in the innovations
    (the filter tracks it), so the check leaves it alone.
 
-Measured (``make bench``, part ``pos_std``, in the README; scans on 2026-11-24, 100-300 s without
-a gap, error / ``pos_std`` RMS N / E / D; 1 is calibrated): paper-001 set-up at 1 Hz, seeds 1-3,
-0.76-0.82 / 0.73-0.81 / 0.98-1.05; at 10 Hz 0.80-0.88 / 0.72-0.86 / 0.98-1.01; the buoy of
-experiment (c) at 1 Hz 0.71-0.73 / 0.63-0.80 / 0.99-1.05; the uncorrected acceleration (east
-14 cm RMS) 0.84-0.91 / 1.05-1.06 / 1.12-1.27 (without step 3: 14 east). Cautious horizontally:
+Measured (``make bench``, part ``pos_std``, 2026-11-24, the README's table; 100-300 s without a
+gap, error / ``pos_std`` RMS per seed N / E / D; 1 is calibrated): paper-001 set-up at 1 Hz,
+seeds 1-10, 0.76-0.91 / 0.72-0.88 / 0.93-1.05; at 10 Hz 0.68-0.88 / 0.72-0.99 / 0.98-1.01; the
+buoy of experiment (c) at 1 Hz 0.66-1.02 / 0.61-0.77 / 0.97-1.05; the uncorrected acceleration
+(east 14 cm RMS) 0.84-0.96 / 1.05-1.15 / 1.12-1.37 (without step 3: 14 east, a scan). Cautious horizontally:
 step 2's loop gives the attitude 0.54-0.65 mrad where the run's erred 0.44-0.50 mrad (seed 1).
 In a GNSS gap bridged by the wave coast ``pos_std`` is the coast's (:mod:`.gnss_fusion`); this
 covariance then follows the filter's, and the fixes after the gap bring it down again.
