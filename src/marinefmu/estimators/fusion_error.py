@@ -135,6 +135,8 @@ class FusionError:
         self.loop = np.zeros((3, 3, 3))             # per NED axis: cov of (ε, β, b)
         self.eps_var = np.zeros(3)                  # attitude error variance over the fix interval [rad²]
         self.q_scale = np.ones(3)                   # per axis, of the acceleration noise density
+        self.q_parts: tuple[np.ndarray, np.ndarray] | None = None  # Q_t's acceleration and bias parts
+        self.Q: np.ndarray | None = None            # Q_t, the former scaled by q_scale
 
     def start(self, p: np.ndarray, fix_attitude_std: np.ndarray) -> None:
         """The filter (re)started on a fix with covariance ``p`` and the fix's attitude, whose
@@ -152,14 +154,23 @@ class FusionError:
         slowly growing error, which step 1 cannot model)."""
         self.P = np.array(p, dtype=float)
 
-    def predict(self, f: np.ndarray, q_acc: np.ndarray, q_bias: np.ndarray) -> None:
-        """One sample: P_t ← Φ P_t Φᵀ + Q_t; ``q_acc`` eq. 16's Q with the density
-        :attr:`q_true` (:func:`~.gnss_fusion.process_noise`), scaled per axis by the
-        consistency check, ``q_bias`` the bias states' part."""
-        if self.P is not None:
-            s = np.ones(len(self.P))
+    def set_process_noise(self, q_acc: np.ndarray, q_bias: np.ndarray) -> None:
+        """Q_t for the step size in use: ``q_acc`` eq. 16's Q with the density :attr:`q_true`
+        (:func:`~.gnss_fusion.process_noise`), which the consistency check scales per axis,
+        and ``q_bias`` the bias states' part."""
+        self.q_parts = (q_acc, q_bias)
+        self._scale_noise()
+
+    def _scale_noise(self) -> None:
+        if self.q_parts is not None:
+            s = np.ones(len(self.q_parts[0]))
             s[0:3] = s[3:6] = np.sqrt(self.q_scale)
-            self.P = f @ self.P @ f.T + s[:, None] * q_acc * s + q_bias
+            self.Q = s[:, None] * self.q_parts[0] * s + self.q_parts[1]
+
+    def predict(self, f: np.ndarray) -> None:
+        """One sample: P_t ← Φ P_t Φᵀ + Q_t (:meth:`set_process_noise`)."""
+        if self.P is not None:
+            self.P = f @ self.P @ f.T + self.Q
 
     def fix(self, innovation: np.ndarray, k: np.ndarray, h: np.ndarray, interval: float) -> None:
         """A GNSS fix was taken with gain ``k`` (observation matrix ``h``) and ``innovation``
@@ -171,6 +182,7 @@ class FusionError:
         w = min(1.0, interval / NIS_MEMORY)
         ratio = np.square(innovation) / s           # 1 on average when the model holds
         self.q_scale = np.clip(self.q_scale * (1.0 + w * (ratio - 1.0)), 1.0, MAX_Q_SCALE)
+        self._scale_noise()
         ikh = np.eye(len(self.P)) - k @ h
         self.P = ikh @ self.P @ ikh.T + (k * self.r_true) @ k.T
 
@@ -222,3 +234,4 @@ class FusionError:
         self.loop = np.array(s["loop"], dtype=float)
         self.eps_var = np.array(s["eps_var"], dtype=float)
         self.q_scale = np.array(s["q_scale"], dtype=float)
+        self._scale_noise()

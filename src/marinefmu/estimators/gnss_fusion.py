@@ -520,7 +520,6 @@ class GnssAccFusion:
         # the covariance of the error as the filter runs, for pos_std outside gaps
         self.error = FusionError(p.arms, p.acc_noise, p.gyro_noise, (p.antenna_sigma_h, p.antenna_sigma_v),
                                  p.gyro_bias_sigma, p.gyro_bias_tau, p.attitude_tau if p.propagation == "gyro" else None)
-        self._q_true: tuple | None = None  # its process noise for _model_dt: acceleration, bias
 
     # ---- per step ----------------------------------------------------------------------------
     def step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None) -> FusionResult:
@@ -575,10 +574,10 @@ class GnssAccFusion:
                 full = process_noise(dt, self.error.q_true, p.bias_rw if p.bias_states else None)
                 acc_part = np.zeros_like(full)
                 acc_part[:6, :6] = full[:6, :6]
-                self._q_true = (acc_part, full - acc_part)
+                self.error.set_process_noise(acc_part, full - acc_part)
                 self._model_dt = dt
             self.kf.predict(u=u.reshape(3, 1))
-            self.error.predict(self.kf.F, *self._q_true)
+            self.error.predict(self.kf.F)
             self.prior = (self.kf.x.copy(), self.kf.P.copy())
         if self.coaster is not None and self.initialised:
             self.coaster.add(quat_to_rot(self.q_coast) @ f_b + GRAVITY_N if self.coast_attitude else self.acc_n, dt)
