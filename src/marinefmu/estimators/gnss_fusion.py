@@ -87,7 +87,7 @@ from scipy.spatial.transform import Rotation
 from ..errors import ParameterError, ShapeError, check_choice, check_range, check_vector
 from ..frames import GRAVITY_N, cross3, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
 from .samples import force_beyond_limit, rate_beyond_limit
-from .fusion_error import FusionError, pi_gains
+from .fusion_error import FusionError, pi_gains, skew
 from .wave_coast import WaveCoast
 
 log = logging.getLogger(__name__)
@@ -353,8 +353,8 @@ def antenna_attitude_std(arms: np.ndarray, rot: np.ndarray, sigma_h: float, sigm
     w = np.diag([sigma_h ** -2, sigma_h ** -2, sigma_v ** -2])
     m = np.zeros((3, 3))
     for r in (arms - arms.mean(axis=0)) @ np.asarray(rot).T:
-        skew = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
-        m += skew.T @ w @ skew
+        c = skew(r)
+        m += c.T @ w @ c
     return np.sqrt(np.diag(np.linalg.inv(m)))
 
 
@@ -651,8 +651,7 @@ class GnssAccFusion:
             rot_c, bias_c = quat_to_rot(self.q_coast), self.coast_bias.copy()
             if self.coaster.tilt is not None:
                 self.coaster.attitude_fix(Rotation.from_matrix(sol.rot @ rot_c.T).as_rotvec(), att_std)
-            self.q_coast, self.coast_bias = pi_pull(self.q_coast, self.coast_bias, sol.rot, min(self.since_fix, 1e9),
-                                                    p.coast_attitude_tau)
+            self.q_coast, self.coast_bias = pi_pull(self.q_coast, self.coast_bias, sol.rot, since, p.coast_attitude_tau)
             if self.coaster.tilt is not None:
                 # true = exp(e)·R = exp(e')·R' → e' = e + rotvec(R R'ᵀ); δ = −R(b − b̂)
                 d_eps = Rotation.from_matrix(rot_c @ quat_to_rot(self.q_coast).T).as_rotvec()
