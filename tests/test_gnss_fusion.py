@@ -235,15 +235,18 @@ def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
 
 def test_the_dropout_bench_reports_errors_and_the_pos_std_check():
     """``paper001.dropouts`` (bench part ``dropout``) on one dropout: the same max error as
-    the fusion run by hand, and the ``pos_std`` check over the coasted part of the gap, from
+    the fusion run by hand, real time and RTS-smoothed, and the ``pos_std`` check over the coasted part of the gap, from
     2 s in (measured RMS z 0.38 / 1.01 / 1.10, as in the dropout test)."""
     d = paper001.dropouts(((300.0, 1),))
     rec = paper001.dropout_record(300.0, 1)
     r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(),
-             gnss_valid=rec["gnss_valid"])
+             gnss_valid=rec["gnss_valid"], smooth=True)
     gap = slice(int(300.0 / paper001.DT), int(330.0 / paper001.DT))
     assert np.allclose(d["cases"][0]["max_error_m"], np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0))
     assert d["over_goal"] == 0 and np.allclose(d["worst_m"], d["mean_m"])
+    smoothed = np.max(np.abs(r["pos_smooth"][gap] - rec["cog"][gap]), axis=0)
+    assert np.allclose(d["cases"][0]["max_error_smoothed_m"], smoothed)
+    assert np.allclose(d["smoothed"]["worst_m"], smoothed) and d["smoothed"]["over_goal"] == 0
     coasted = slice(int(302.0 / paper001.DT), gap.stop)
     z = (r["pos"][coasted] - rec["cog"][coasted]) / r["pos_std"][coasted]
     assert np.allclose(d["pos_std"]["rms_z"], np.sqrt(np.mean(z**2, axis=0)))
