@@ -8,7 +8,7 @@ import pytest
 
 from marinefmu.estimators import fusion_error
 from marinefmu.estimators.fusion_error import FusionError, loop_interval, pi_gains
-from marinefmu.estimators.gnss_fusion import antenna_attitude_std
+from marinefmu.estimators.antenna_attitude import antenna_attitude_std
 from marinefmu.estimators.gnss_fusion import FusionParams, GnssAccFusion
 from marinefmu.examples import paper001
 

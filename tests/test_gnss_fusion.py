@@ -8,10 +8,9 @@ from filterpy.kalman import KalmanFilter
 from scipy.spatial.transform import Rotation
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.gnss_fusion import (
-    DEFAULT_ANTENNAS, FusionParams, GnssAccFusion, antenna_attitude, antenna_attitude_std, fuse, process_noise,
-    transition,
-)
+from marinefmu.estimators.antenna_attitude import DEFAULT_ANTENNAS, antenna_attitude, antenna_attitude_std
+from marinefmu.estimators.fusion_runs import fuse, fuse_receiver
+from marinefmu.estimators.gnss_fusion import FusionParams, GnssAccFusion, process_noise, transition
 from marinefmu.estimators.integration import integrate_frequency, integrate_time
 from marinefmu.estimators.wave_coast import WaveCoast, coast_floor
 from marinefmu.examples import paper001
@@ -417,7 +416,6 @@ def test_q_down_sets_the_down_axis_process_noise_only():
 
 def test_one_receiver_fusion_returns_the_fix_of_a_still_point():
     """fuse_receiver: the four-antenna filter on one receiver (virtual rigid antenna set)."""
-    from marinefmu.estimators.gnss_fusion import fuse_receiver
 
     n, dt = 500, 0.1
     f_n = np.tile([0.0, 0.0, -9.80665], (n, 1))
@@ -434,7 +432,6 @@ def test_one_receiver_pos_std_is_the_receivers():
     500 independent fixes, but the filter's memory spans several). Before, the virtual antennas'
     centroid was taken for the mean of four independent antennas (σ/2) and their 10 m mean arm
     added a fix attitude's share (1.9 cm) that a rigid virtual set does not have."""
-    from marinefmu.estimators.gnss_fusion import fuse_receiver
 
     rng = np.random.default_rng(5)
     n, dt = 60000, 0.01

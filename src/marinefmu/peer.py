@@ -89,7 +89,7 @@ def aided_ins_cog(acc: np.ndarray, gyro: np.ndarray, gnss: np.ndarray, gnss_new:
     """
     from scipy.spatial.transform import Rotation
 
-    from .estimators.gnss_fusion import antenna_attitude
+    from .estimators.antenna_attitude import antenna_attitude
 
     imu, receiver = imu or ImuParams(), receiver or GnssParams()
     arms, arm = np.asarray(antennas, dtype=float), np.asarray(imu_arm, dtype=float)
@@ -128,7 +128,9 @@ def compare_gnss_aided(rec: dict[str, np.ndarray], dt: float, imu_arm: tuple[flo
     with VesselMotion's default antennas."""
     from dataclasses import replace
 
-    from .estimators.gnss_fusion import DEFAULT_ANTENNAS, FusionParams, fuse
+    from .estimators.antenna_attitude import DEFAULT_ANTENNAS
+    from .estimators.fusion_runs import fuse
+    from .estimators.gnss_fusion import FusionParams
     from .sea.motion_model import stack
 
     acc, gyro = stack(rec, "imu.acc"), stack(rec, "imu.gyro")

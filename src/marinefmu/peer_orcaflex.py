@@ -23,7 +23,7 @@ Errors are scored, as smsfusion's test does, from sample 600 (58.6 s) on.
   accelerometer-only heave filter to put beside it.
 - **GNSS-aided position** (1 Hz fixes, every 10th sample, as smsfusion's test aids its INS):
   the fusion filter of :mod:`~.estimators.gnss_fusion` on one receiver
-  (:func:`~.estimators.gnss_fusion.fuse_receiver`; the specific force rotated with the
+  (:func:`~.estimators.fusion_runs.fuse_receiver`; the specific force rotated with the
   AttitudeEstimator's roll and pitch and the compass heading) against smsfusion's
   ``AidedINS`` aided by the same fixes and compass. The fusion's ``q`` and ``q_down`` are not
   tuned on this record: :func:`tune_receiver_q` picks them on a VesselMotion record with the
@@ -195,7 +195,8 @@ def receiver_fusion(f_n: np.ndarray, gnss: np.ndarray, dt: float, q: tuple[float
     ``coast="inertial"``: the records have no gap longer than the 2 s after which the default
     wave-model coast would start, so it would only cost time (its band observers are 95 % of
     the run) and change nothing."""
-    from .estimators.gnss_fusion import FusionParams, fuse_receiver
+    from .estimators.fusion_runs import fuse_receiver
+    from .estimators.gnss_fusion import FusionParams
 
     new = np.arange(len(f_n)) % FIX_EVERY == 0
     params = FusionParams(q=q[0], q_down=q[1], r=RECEIVER_SIGMA ** 2 * dt, coast="inertial")

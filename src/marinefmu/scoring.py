@@ -88,9 +88,9 @@ def _span(result: np.ndarray, comp: str, settle: float) -> np.ndarray:
 
 def _raw_gnss(result: np.ndarray, comp, vessel: str, antennas: list[str], span: np.ndarray) -> dict[str, float]:
     """RMS error [cm] per NED axis of the COG fixed from the raw antenna positions alone
-    (:func:`~.estimators.gnss_fusion.antenna_attitude` with the fusion's lever arms) at the
+    (:func:`~.estimators.antenna_attitude.antenna_attitude` with the fusion's lever arms) at the
     GNSS epochs in ``span``: the yardstick of issue 4's goal, fused error ≤ 0.5 × raw."""
-    from .estimators.gnss_fusion import DEFAULT_ANTENNAS, antenna_attitude
+    from .estimators.antenna_attitude import DEFAULT_ANTENNAS, antenna_attitude
 
     arms = np.array([[float(comp.parameters.get(f"ant{i + 1}.{a}", DEFAULT_ANTENNAS[i][j])) for j, a in enumerate("xyz")]
                      for i in range(4)])

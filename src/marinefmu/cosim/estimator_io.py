@@ -10,7 +10,8 @@ from ..estimators.centre_of_rotation import CentreOfRotationParams
 from ..estimators.band_bank import BAND_VARIANCES
 from ..estimators.heave import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
 from ..estimators.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
-from ..estimators.gnss_fusion import ANTENNAS, COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
+from ..estimators.antenna_attitude import ANTENNAS
+from ..estimators.gnss_fusion import COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, FusionParams
 from ..estimators.reconstruction import TILT_CHOICES
 from ..estimators.sliding_reconstruction import SlidingParams
 from ..interface import Variable, real, resolve, vec

@@ -78,7 +78,7 @@ Now the north and east filters carry ε and the gyro-bias error δ that turns it
 
 with ``gain``·ε in the acceleration row (and −J·gain in Ā, the increment form's feed-through),
 measured at every fix by the antenna attitude's error against the coast's attitude (σ from the
-antenna geometry, :func:`~.gnss_fusion.antenna_attitude_std`: 1.9 / 0.75 mrad about N / E on
+antenna geometry, :func:`~.antenna_attitude.antenna_attitude_std`: 1.9 / 0.75 mrad about N / E on
 the paper-001 set-up, as measured). The coast's PI pulls move ε and δ by known amounts
 (:meth:`AidedBand.shift_tilt`). The offset keeps the heave observer's noise (1e-4), the
 accelerometer bias alone; at the first band model it restarts at 0 ± 2 mm/s², because the

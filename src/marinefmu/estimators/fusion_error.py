@@ -23,7 +23,7 @@ the filter, without changing the fused output:
    (:func:`~.gnss_fusion.pi_pull`) as it runs, per NED axis: states (ε, β, b) — the attitude
    error, the gyro-bias error and the true Gauss-Markov bias (``gyro_bias_sigma``,
    ``gyro_bias_tau``), the gyro's angle random walk ``gyro_noise`` — pulled at each fix with
-   the loop's gains and the fix attitude's noise (:func:`~.gnss_fusion.antenna_attitude_std`).
+   the loop's gains and the fix attitude's noise (:func:`~.antenna_attitude.antenna_attitude_std`).
    With ``propagation="hold"`` it is the fix attitude's noise alone.
 3. **A consistency check** (covariance matching: Mehra 1972; Myers & Tapley 1976): at each fix
    the innovation's square over its predicted variance, r = ν²/(H P_t⁻ Hᵀ + R_t), is 1 on

@@ -3,12 +3,10 @@
 Frames: the paper works in ENU with z up; here everything is NED/FRD (DESIGN.md) — positions
 north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +g].
 
-1. **Attitude from the antennas** (:func:`antenna_attitude`): the four measured antenna
-   positions p_i (NED) and their body lever arms l_i relative to the COG satisfy
-   p_i = p_c + R_nb l_i. The least-squares R_nb is Wahba's problem on the centred sets, solved
-   by ``scipy.spatial.transform.Rotation.align_vectors`` (the paper: "a relatively simple
-   least squares method"); then p_c = mean(p_i) − R mean(l_i), and the RMS fit residual is the
-   quality output. NaN coordinates or antennas that do not span a plane skip the epoch.
+1. **Attitude from the antennas** (:mod:`.antenna_attitude`): the least-squares attitude
+   (Wahba's problem) and COG position of the four measured antenna positions, and the RMS fit
+   residual as the quality output. NaN coordinates or antennas that do not span a plane skip
+   the epoch.
 2. **Attitude-corrected acceleration** (eqs. 25-26 in our convention):
    a_n = R_nb f_b + g_n. Without correction (the paper's "before" case) the sensor axes are
    taken as the n axes: a_n = f_b + g_n. Between GNSS epochs the paper interpolates the
@@ -41,9 +39,9 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    re-initialisation on GNSS after ``reinit_time`` s of consecutive rejections (a real
    reposition, not a glitch) and on the first fix after a gap longer than ``max_coast`` (with
    the velocity the wave coast held, when it bridged the gap); and
-   an RTS fixed-interval smoother for post-processing (:func:`fuse`, ``smooth=True``;
-   hand-written because filterpy's ``rts_smoother`` has no control input, and here
-   x⁻_{k+1} = Φ x_k + G u_k).
+   an RTS fixed-interval smoother for post-processing (:func:`~.fusion_runs.fuse`,
+   ``smooth=True``; hand-written because filterpy's ``rts_smoother`` has no control input,
+   and here x⁻_{k+1} = Φ x_k + G u_k).
 4. **Coasting through GNSS dropouts** (``coast``, beyond the paper). ``"inertial"`` predicts
    only; with a MEMS gyro this drifts by metres in 30 s whatever the filter (the gyro bias
    wander alone: :func:`~.wave_coast.coast_floor`, 0.87 m RMS per axis after 30 s for
@@ -84,15 +82,15 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 from scipy.spatial.transform import Rotation
 
-from ..errors import ParameterError, ShapeError, check_choice, check_range, check_vector
+from ..errors import ParameterError, check_choice, check_range, check_vector
 from ..frames import GRAVITY_N, cross3, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
 from .samples import force_beyond_limit, rate_beyond_limit
-from .fusion_error import FusionError, pi_gains, skew
+from .antenna_attitude import ANTENNAS, DEFAULT_ANTENNAS, MIN_SPREAD, AntennaFix, antenna_attitude, antenna_attitude_std
+from .fusion_error import FusionError, pi_gains
 from .wave_coast import WaveCoast
 
 log = logging.getLogger(__name__)
 
-ANTENNAS = 4
 PROPAGATION_CHOICES = ("gyro", "hold")
 STEP_INPUT_CHOICES = ("mean", "latest")
 COAST_CHOICES = ("band", "inertial")
@@ -109,10 +107,6 @@ COAST_INTERVAL = 0.1
 #: ``pos_std`` adds to the coast's own variance in a gap (a memory of about 2 s at
 #: :data:`COAST_INTERVAL`; module docstring).
 TRACK_WEIGHT = 0.05
-#: Default antenna lever arms [m] (body frame, relative to the COG): VesselMotion's defaults.
-DEFAULT_ANTENNAS = ((10.0, -4.0, -10.0), (10.0, 4.0, -10.0), (-10.0, -4.0, -10.0), (-10.0, 4.0, -10.0))
-#: Smallest second singular value [m] of the centred antenna positions (they must span a plane).
-MIN_SPREAD = 0.05
 
 
 @dataclass(frozen=True)
@@ -206,7 +200,7 @@ class FusionParams:
         Its correlation time [s], 0.1 … 1e6. [``gyro_bias_tau``]
     antenna_sigma_h, antenna_sigma_v : float
         Standard deviation of one antenna position, horizontal and vertical [m], (0, 100]: the
-        weight of a fix's attitude in the tilt states (:func:`antenna_attitude_std`; RTK 1 and
+        weight of a fix's attitude in the tilt states (:func:`~.antenna_attitude.antenna_attitude_std`; RTK 1 and
         1.5 cm) and the fix noise of ``pos_std`` (:mod:`.fusion_error`). [``antenna_sigma_h``,
         ``antenna_sigma_v``]
     acc_noise : float
@@ -282,80 +276,6 @@ class FusionParams:
         check_range("antenna_sigma_v", self.antenna_sigma_v, lo=0.0, lo_open=True, hi=100.0, unit="m")
         check_range("acc_noise", self.acc_noise, lo=0.0, lo_open=True, hi=10.0, unit="m/s2/sqrt(Hz)")
         check_range("gyro_noise", self.gyro_noise, lo=0.0, lo_open=True, hi=1.0, unit="rad/s/sqrt(Hz)")
-
-
-@dataclass(frozen=True)
-class AntennaFix:
-    """Attitude and COG position from one GNSS epoch (:func:`antenna_attitude`).
-
-    Attributes
-    ----------
-    rot : numpy.ndarray
-        (3, 3) R_nb (body → NED).
-    cog : numpy.ndarray
-        (3,) COG position, NED [m].
-    residual : float
-        RMS distance between measured and fitted antenna positions [m].
-    centroid : numpy.ndarray
-        (3,) mean of the measured antenna positions, NED [m].
-    """
-
-    rot: np.ndarray
-    cog: np.ndarray
-    residual: float
-    centroid: np.ndarray
-
-
-def antenna_attitude(positions: np.ndarray, arms: np.ndarray) -> AntennaFix | str:
-    """Least-squares attitude and COG position from antenna positions (Wahba's problem).
-
-    Parameters
-    ----------
-    positions : numpy.ndarray
-        (4, 3) measured antenna positions, NED [m].
-    arms : numpy.ndarray
-        (4, 3) antenna lever arms relative to the COG, body frame [m].
-
-    Returns
-    -------
-    AntennaFix or str
-        The fix, or the reason the epoch is unusable (non-finite, degenerate geometry).
-    """
-    p = np.asarray(positions, dtype=float).reshape(ANTENNAS, 3)
-    if not np.all(np.isfinite(p)):
-        return "non-finite antenna coordinates"
-    pc, lc = p.mean(axis=0), arms.mean(axis=0)
-    dp = p - pc
-    if np.linalg.svd(dp, compute_uv=False)[1] < MIN_SPREAD:
-        return "degenerate antenna geometry (coincident or collinear positions)"
-    rot, _ = Rotation.align_vectors(dp, arms - lc)
-    r = rot.as_matrix()
-    cog = pc - r @ lc
-    resid = p - (cog + arms @ r.T)
-    return AntennaFix(r, cog, float(math.sqrt(np.mean(np.sum(resid ** 2, axis=1)))), pc)
-
-
-def antenna_attitude_std(arms: np.ndarray, rot: np.ndarray, sigma_h: float, sigma_v: float) -> np.ndarray:
-    """Standard deviations [rad] of the least-squares antenna attitude's error about the N, E
-    and D axes, to first order, for independent antenna errors of ``sigma_h`` (north, east) and
-    ``sigma_v`` (down) [m].
-
-    An attitude error θ (n frame) moves antenna i by θ × r_i, r_i = R (arm_i − mean arm); the
-    weighted least-squares covariance is (Σ [r_i]×ᵀ W [r_i]×)⁻¹, W = diag(σ_h⁻², σ_h⁻², σ_v⁻²)
-    (the centroid decouples, the arms being centred).
-
-    Examples
-    --------
-    >>> arms = np.array(DEFAULT_ANTENNAS)
-    >>> (1e3 * antenna_attitude_std(arms, np.eye(3), 0.01, 0.015)).round(2)  # 8 m wide, 20 m long
-    array([1.88, 0.75, 0.46])
-    """
-    w = np.diag([sigma_h ** -2, sigma_h ** -2, sigma_v ** -2])
-    m = np.zeros((3, 3))
-    for r in (arms - arms.mean(axis=0)) @ np.asarray(rot).T:
-        c = skew(r)
-        m += c.T @ w @ c
-    return np.sqrt(np.diag(np.linalg.inv(m)))
 
 
 @dataclass(frozen=True)
@@ -786,132 +706,3 @@ class GnssAccFusion:
         if self.coaster is not None:
             self.coaster.set_state(s["coaster"])
         self.error.set_state(s["error"])
-
-
-def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyro: np.ndarray | None = None,
-         params: FusionParams | None = None, smooth: bool = False, gnss_valid: np.ndarray | None = None
-         ) -> dict[str, np.ndarray]:
-    """Run :class:`GnssAccFusion` over whole records, optionally with the RTS smoother.
-
-    Parameters
-    ----------
-    acc : numpy.ndarray
-        (N, 3) specific force [m/s², b] at t_k = (k + 1)·dt.
-    dt : float
-        Sample interval [s].
-    gnss : numpy.ndarray
-        (N, 12) antenna positions (ant1 n, e, d, ant2, …) [m], read where ``gnss_new``.
-    gnss_new : numpy.ndarray
-        (N,) bool, True at the samples where a new epoch arrived.
-    gnss_valid : numpy.ndarray, optional
-        (N,) bool receiver validity (VesselMotion's ``gnss.valid``); epochs where it is False
-        are not used (a receiver in dropout repeats its last fix).
-    gyro : numpy.ndarray, optional
-        (N, 3) angular rate [rad/s, b].
-    params : FusionParams, optional
-    smooth : bool
-        Also return the RTS fixed-interval smoothed ``pos_smooth`` and ``vel_smooth``.
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        ``pos``, ``vel``, ``pos_std``, ``euler``, ``acc_n``, ``acc_bias`` (N, 3); ``valid`` (N,);
-        ``fix`` (N,) str; with ``smooth``, ``pos_smooth`` and ``vel_smooth`` (N, 3).
-    """
-    acc = np.asarray(acc, dtype=float)
-    n = len(acc)
-    if acc.shape != (n, 3) or np.shape(gnss) != (n, 12) or np.shape(gnss_new) != (n,):
-        raise ShapeError(f"expected acc (N, 3), gnss (N, 12), gnss_new (N,); got {acc.shape}, {np.shape(gnss)}, {np.shape(gnss_new)}")
-    est = GnssAccFusion(params)
-    out = {k: np.empty((n, 3)) for k in ("pos", "vel", "pos_std", "euler", "acc_n", "acc_bias")}
-    out["valid"] = np.empty(n, dtype=bool)
-    out["fix"] = np.empty(n, dtype=object)
-    keep = smooth and n > 1
-    nx = est.kf.dim_x
-    xs = np.zeros((n, nx)) if keep else None
-    ps = np.zeros((n, nx, nx)) if keep else None
-    priors: list = [None] * n
-    arms = np.zeros((n, 3))
-    use = np.asarray(gnss_new, dtype=bool) & (True if gnss_valid is None else np.asarray(gnss_valid, dtype=bool))
-    for k in range(n):
-        r = est.step(acc[k], gnss[k] if use[k] else None, dt, None if gyro is None else gyro[k])
-        for key in ("pos", "vel", "pos_std", "euler", "acc_n", "acc_bias"):
-            out[key][k] = getattr(r, key)
-        out["valid"][k], out["fix"][k] = r.valid, r.fix
-        if keep:
-            xs[k], ps[k] = est.kf.x.ravel(), est.kf.P
-            priors[k] = est.prior
-            arms[k] = out["pos"][k] - est.kf.x.ravel()[:3] if est.initialised else 0.0
-    if keep:
-        f = transition(dt, est.params.bias_states)[0]
-        sx, _ = rts_smooth(xs, ps, priors, f)
-        out["pos_smooth"] = sx[:, :3] + arms
-        out["vel_smooth"] = sx[:, 3:6] + (out["vel"] - xs[:, 3:6])
-    return out
-
-
-def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarray,
-                  params: FusionParams | None = None) -> dict[str, np.ndarray]:
-    """The fusion filter on one GNSS receiver, with the attitude applied by the caller.
-
-    For a data set with a single antenna (and a compass) instead of four: ``f_n`` is the
-    specific force already rotated into NED by an external attitude (eqs. 25-26 done
-    outside: f_n = R_nb f_b), ``pos`` the receiver's fixes of the accelerometer point.
-    :class:`GnssAccFusion` runs with ``attitude_correction=False`` (a_n = f_n + g_n),
-    ``propagation="hold"`` and no lever arm, and each fix is handed to it as a rigid antenna
-    set at identity attitude around the fix (the antenna solution then returns exactly the
-    fix), so the Kalman filter, gating, bias states, coasting and re-initialisation are the
-    same code as the four-antenna estimator's.
-
-    Parameters
-    ----------
-    f_n : numpy.ndarray
-        (N, 3) specific force in NED [m/s²] at t_k = (k + 1)·dt.
-    dt : float
-        Sample interval [s].
-    pos : numpy.ndarray
-        (N, 3) receiver position of the accelerometer point, NED [m], read where ``pos_new``.
-    pos_new : numpy.ndarray
-        (N,) bool, True where a new fix arrived.
-    params : FusionParams, optional
-        ``q``, ``q_down``, ``r``, ``gate``, ``bias_states`` … (its antennas, lever arm,
-        attitude correction and propagation are overridden as above). ``antenna_sigma_h`` and
-        ``antenna_sigma_v`` are the receiver's noise, for ``pos_std``.
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        As :func:`fuse`.
-    """
-    from dataclasses import replace
-
-    p = params or FusionParams()
-    # centred virtual antennas: the attitude is exact and has no share in pos_std; they carry the
-    # receiver's one error, so the centroid's noise is the receiver's (fusion_error: σ²/4)
-    p = replace(p, attitude_correction=False, propagation="hold", acc_lever_arm=(0.0, 0.0, 0.0),
-                antennas=tuple(tuple(a) for a in (p.arms - p.arms.mean(axis=0)).tolist()),
-                antenna_sigma_h=2.0 * p.antenna_sigma_h, antenna_sigma_v=2.0 * p.antenna_sigma_v)
-    pos = np.asarray(pos, dtype=float)
-    if pos.ndim != 2 or pos.shape[1] != 3:
-        raise ShapeError(f"expected pos (N, 3); got {pos.shape}")
-    virtual = np.hstack([pos + arm for arm in p.arms])
-    return fuse(f_n, dt, virtual, pos_new, None, p)
-
-
-def rts_smooth(xs: np.ndarray, ps: np.ndarray, priors: list, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rauch–Tung–Striebel fixed-interval smoothing of a filtered run with a control input.
-
-    ``xs``/``ps`` are the filtered x_k, P_k; ``priors[k]`` the (x⁻_k, P⁻_k) predicted into
-    step k (None where the filter started or restarted: the recursion does not cross those).
-    x^s_k = x_k + C_k (x^s_{k+1} − x⁻_{k+1}), C_k = P_k Φᵀ (P⁻_{k+1})⁻¹.
-    """
-    sx, sp = xs.copy(), ps.copy()
-    for k in range(len(xs) - 2, -1, -1):
-        prior = priors[k + 1]
-        if prior is None:
-            continue
-        xp, pp = prior[0].ravel(), prior[1]
-        c = np.linalg.solve(pp.T, (ps[k] @ f.T).T).T
-        sx[k] = xs[k] + c @ (sx[k + 1] - xp)
-        sp[k] = ps[k] + c @ (sp[k + 1] - pp) @ c.T
-    return sx, sp

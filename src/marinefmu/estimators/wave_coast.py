@@ -214,7 +214,7 @@ class WaveCoast:
     def attitude_fix(self, e_n: np.ndarray, sigma_n: np.ndarray) -> None:
         """Update the tilt states with the error of the correcting attitude that a fix's antenna
         attitude measured, e_n [rad, NED rotation vector, true = exp(e_n)·used], of standard
-        deviations ``sigma_n`` [rad, NED] (:func:`~.gnss_fusion.antenna_attitude_std`)."""
+        deviations ``sigma_n`` [rad, NED] (:func:`~.antenna_attitude.antenna_attitude_std`)."""
         if not self.ready or self.tilt is None:
             return
         lead = self._lead()

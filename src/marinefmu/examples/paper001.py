@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 from scipy import signal
 
-from ..estimators.gnss_fusion import COAST_AFTER, FusionParams, fuse
+from ..estimators.fusion_runs import fuse
+from ..estimators.gnss_fusion import COAST_AFTER, FusionParams
 from ..sea.motion_model import VesselMotionParams, simulate_record, stack
 from ..sea.vessel import preset_raos, save_rao_csv
 
@@ -55,7 +56,7 @@ def simulate(duration: float, extra: dict | None = None) -> dict[str, np.ndarray
 
 def raw_gnss_cog(rec: dict) -> np.ndarray:
     """COG from the latest GNSS epoch held between epochs (what GNSS alone gives) [m]."""
-    from ..estimators.gnss_fusion import antenna_attitude
+    from ..estimators.antenna_attitude import antenna_attitude
 
     arms = np.array(ANT)
     out = np.full((len(rec["acc"]), 3), np.nan)
@@ -223,7 +224,7 @@ def buoy(duration: float = 600.0, settle: float = 60.0, height: float = 0.97) ->
     new = rec["gnss_new"]
     s = np.arange(len(new)) >= int(settle / DT)
     cen = rec["gnss"][:, 2::3].mean(axis=1) + height  # antenna elevation (down) moved to the waterline
-    from ..estimators.gnss_fusion import antenna_attitude
+    from ..estimators.antenna_attitude import antenna_attitude
 
     fix_d = np.array([antenna_attitude(g, np.array(ant)).cog[2] for g in rec["gnss"][new & s]])
     r = fuse(rec["acc"], DT, rec["gnss"], new, rec["gyro"], fusion)
@@ -276,7 +277,7 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
     all cases per axis — ``rms_z`` (RMS of error / ``pos_std``; 1 is calibrated, below 1
     cautious), ``beyond_2`` and ``beyond_3`` (fractions of the time |z| > 2 and > 3; 4.6 % and
     0.27 % for a Gaussian), ``mean_std_m`` and ``rms_error_m``. The same for the RTS-smoothed
-    output (post-processing, :func:`~marinefmu.estimators.gnss_fusion.fuse` with ``smooth``;
+    output (post-processing, :func:`~marinefmu.estimators.fusion_runs.fuse` with ``smooth``;
     the record runs on 10 s after the gap, so the smoother has 10 s of fixes after it): per case
     ``max_error_smoothed_m``, and ``smoothed`` with its ``over_goal``, ``worst_m`` and
     ``mean_m``. Prints one line per case as it goes (about 5 s each, 20 s at
