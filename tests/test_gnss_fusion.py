@@ -443,3 +443,33 @@ def test_one_receiver_pos_std_is_the_receivers():
     z = (out["pos"][s] - [3.0, -2.0, 0.5]) / out["pos_std"][s]
     rms_z = np.sqrt(np.mean(z**2, axis=0))
     assert np.all((rms_z > 0.75) & (rms_z < 1.3)), rms_z
+
+
+def test_orphan_steps_are_those_no_later_fix_reaches():
+    """A step is orphan when the filter restarts (or the record ends) before another fix."""
+    from marinefmu.estimators.fusion_runs import orphan_steps
+
+    priors = [None, 1, 1, 1, 1, None, 1]
+    assert orphan_steps(priors, np.array([1, 0, 1, 0, 0, 1, 0], bool)).tolist() == [False, False, True, True, True,
+                                                                                     True, True]
+    # fixes keep coming: nothing orphan but the steps after the last fix
+    assert orphan_steps([None, 1, 1, 1], np.array([1, 0, 1, 0], bool)).tolist() == [False, False, True, True]
+
+
+def test_smoother_keeps_the_real_time_output_through_a_gap_ending_in_a_restart():
+    """A 70 s dropout (> ``max_coast``, 60 s) ends in a re-initialisation, across which the
+    smoother has no fix: over the gap ``pos_smooth`` is ``pos`` (before, the filter's bias
+    drift in the gap was spread back over it: 5-min gaps 31.0 cm east against 23.5 cm real
+    time, README), while before the gap, with fixes after each step, it still smooths.
+    Measured before this: the smoothed east RMS over the gap 8.04 cm against 7.78 real time."""
+    rec = paper001.dropout_record(200.0, 2, 70.0)
+    r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(),
+             gnss_valid=rec["gnss_valid"], smooth=True)
+    restart = int(np.flatnonzero(rec["gnss_new"] & rec["gnss_valid"] & (np.arange(len(rec["acc"])) > 20000))[0])
+    last_fix = int(np.flatnonzero(rec["gnss_new"] & rec["gnss_valid"] & (np.arange(len(rec["acc"])) < 20000))[-1])
+    assert np.array_equal(r["pos_smooth"][last_fix:restart], r["pos"][last_fix:restart])
+    before = slice(last_fix - 10000, last_fix)
+    assert np.max(np.abs(r["pos_smooth"][before] - r["pos"][before])) > 1e-3
+    # and the smoother still does its job there: down 0.44 against 0.96 cm RMS real time (measured)
+    e, es = (np.sqrt(np.mean((x[before, 2] - rec["cog"][before, 2]) ** 2)) for x in (r["pos"], r["pos_smooth"]))
+    assert es < 0.6 * e, (es, e)
