@@ -38,8 +38,11 @@ Measured (``make bench``, part ``pos_std``, 2026-11-24, the README's table; 100-
 gap, error / ``pos_std`` RMS per seed N / E / D; 1 is calibrated): paper-001 set-up at 1 Hz,
 seeds 1-10, 0.76-0.91 / 0.72-0.88 / 0.93-1.05; at 10 Hz 0.68-0.88 / 0.72-0.99 / 0.98-1.01; the
 buoy of experiment (c) at 1 Hz 0.66-1.02 / 0.61-0.77 / 0.97-1.05; the uncorrected acceleration
-(east 14 cm RMS) 0.84-0.96 / 1.05-1.15 / 1.12-1.37 (without step 3: 14 east, a scan). Cautious horizontally:
-step 2's loop gives the attitude 0.54-0.65 mrad where the run's erred 0.44-0.50 mrad (seed 1).
+(east 14 cm RMS) 0.84-0.96 / 1.05-1.15 / 1.12-1.37 (without step 3: 14 east, a scan). Cautious
+horizontally, and after a GNSS gap for about a minute (east 0.66, seeds 1-20, a scan), though
+step 2's loop is calibrated (roll error 0.59 / 0.90 mrad RMS against its 0.645 / 0.96 mrad,
+steady / after the gap): step 2's share and step 1's position error are added as independent,
+and they partly cancel (correlation −0.47 / −0.64 east, a scan; README).
 In a GNSS gap bridged by the wave coast ``pos_std`` is the coast's (:mod:`.gnss_fusion`); this
 covariance then follows the filter's, and the fixes after the gap bring it down again.
 
