@@ -438,8 +438,9 @@ class GnssAccFusion:
         self.coast_var: np.ndarray | None = None  # coast position variance at the last pseudo-fix [m²]
         self.coast_track: np.ndarray | None = None  # mean square of the pseudo-fix innovations [m²]
         # the covariance of the error as the filter runs, for pos_std outside gaps
-        self.error = FusionError(p.arms, p.acc_noise, p.gyro_noise, (p.antenna_sigma_h, p.antenna_sigma_v),
-                                 p.gyro_bias_sigma, p.gyro_bias_tau, p.attitude_tau if p.propagation == "gyro" else None)
+        self.error = FusionError(p.arms, np.asarray(p.acc_lever_arm), p.acc_noise, p.gyro_noise, (p.antenna_sigma_h, p.antenna_sigma_v),
+                                 p.gyro_bias_sigma, p.gyro_bias_tau, p.attitude_tau if p.propagation == "gyro" else None,
+                                 p.attitude_correction)
 
     # ---- per step ----------------------------------------------------------------------------
     def step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None) -> FusionResult:
@@ -494,10 +495,10 @@ class GnssAccFusion:
                 full = process_noise(dt, self.error.q_true, p.bias_rw if p.bias_states else None)
                 acc_part = np.zeros_like(full)
                 acc_part[:6, :6] = full[:6, :6]
-                self.error.set_process_noise(acc_part, full - acc_part)
+                self.error.set_model(self.kf.F, self.kf.B, acc_part, full - acc_part, dt)
                 self._model_dt = dt
             self.kf.predict(u=u.reshape(3, 1))
-            self.error.predict(self.kf.F)
+            self.error.predict()
             self.prior = (self.kf.x.copy(), self.kf.P.copy())
         if self.coaster is not None and self.initialised:
             self.coaster.add(quat_to_rot(self.q_coast) @ f_b + GRAVITY_N if self.coast_attitude else self.acc_n, dt)
@@ -562,7 +563,7 @@ class GnssAccFusion:
             return "rejected", f"GNSS epoch rejected: innovation {d:.1f} sigma > gate {p.gate}"
         self.kf.update(z, R=r_meas)
         since = min(self.since_fix, 1e9)
-        self.error.fix(y, self.kf.K, self.kf.H, since)
+        self.error.fix(y, self.kf.K, self.kf.H, since, rot_arm)
         if self.coaster is not None:
             self.coaster.anchor(z)
         att_std = antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v)
@@ -622,7 +623,7 @@ class GnssAccFusion:
         self.prior = None  # a restart: nothing to smooth across
         self.kf.x = x
         self.kf.P = np.diag(var)
-        self.error.start(self.kf.P, antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v))
+        self.error.start(self.kf.P, antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v), sol.rot)
         self.q = Rotation.from_matrix(sol.rot).as_quat(scalar_first=True)
         self.q_coast = self.q.copy()
         self.coast_var = self.coast_track = None
@@ -650,7 +651,7 @@ class GnssAccFusion:
             self.q = Rotation.from_matrix(rot_fix).as_quat(scalar_first=True)
             self.error.attitude_fix(fix_std, dt_fix)
             return
-        alpha = np.minimum(pi_gains(dt_fix, p.attitude_tau)[0], self.error.attitude_gain(fix_std, dt_fix))
+        alpha = np.minimum(pi_gains(dt_fix, p.attitude_tau)[0], self.error.attitude_gain(fix_std))
         self.q, self.gyro_bias = pi_pull(self.q, self.gyro_bias, rot_fix, dt_fix, p.attitude_tau, alpha)
         self.error.attitude_fix(fix_std, dt_fix, alpha)
 
