@@ -302,7 +302,7 @@ class FusionError:
         if self.joint is None:
             return np.zeros(3)
         m = self.output_map(rot)
-        return np.einsum("ij,jk,ik->i", m, self.joint, m)
+        return np.maximum(np.einsum("ij,jk,ik->i", m, self.joint, m), 0.0)   # rounding: never negative
 
     # ---- state -------------------------------------------------------------------------------
     def get_state(self) -> dict:
