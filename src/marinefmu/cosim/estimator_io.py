@@ -138,7 +138,7 @@ FUSION_INPUTS: list[Variable] = [
 FUSION_OUTPUTS: list[Variable] = [
     *vec("pos", "ned", 0.0, "m", "Fused COG position, NED"),
     *vec("vel", "ned", 0.0, "m/s", "Fused COG velocity, NED"),
-    *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (the error covariance of the filter as run, with the sensor noises; in a gap the wave coast's own plus the output's spread about it), NED"),
+    *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (the error covariance of the filter as run, with the sensor noises and the attitude error; in a gap the wave coast's own plus the output's spread about it), NED"),
     real("roll", 0.0, "rad", "Roll used for the correction (antennas, gyro-propagated)"),
     real("pitch", 0.0, "rad", "Pitch used for the correction"),
     real("yaw", 0.0, "rad", "Yaw used for the correction"),
