@@ -159,7 +159,7 @@ class FusionError:
         """Forget everything (no fix yet)."""
         self.joint: np.ndarray | None = None        # covariance of (e, ε, β, b) [SI]
         self.q_scale = np.ones(3)                   # per axis, of the acceleration noise density
-        self.model: tuple | None = None             # (Φ, Γ, Q_t's acceleration part, the rest, A, Q_loop)
+        self.model: tuple | None = None             # (Q_t's acceleration part, its bias part, the loop's noise)
         self.phi: np.ndarray | None = None          # the joint transition of one sample
         self.Q: np.ndarray | None = None            # the joint process noise of one sample
 
