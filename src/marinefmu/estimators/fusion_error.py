@@ -185,10 +185,11 @@ class FusionError:
         j[:nx, :nx] = p
         j[nx:nx + 3, nx:nx + 3] = np.diag(s2)
         j[nx + 3:, nx + 3:] = np.kron(np.ones((2, 2)), b2 * np.eye(3))   # b̂ kept, b unknown: β and b alike
-        c = self._fix_arm(rot) * s2                 # cov(e_pos, ε) = S Σ_ε
+        sa = self._fix_arm(rot)
+        c = sa * s2                                 # cov(e_pos, ε) = S Σ_ε
         j[:3, nx:nx + 3] = c
         j[nx:nx + 3, :3] = c.T
-        j[:3, :3] += c @ self._fix_arm(rot).T
+        j[:3, :3] += c @ sa.T
         self.joint = j
 
     def follow(self, p: np.ndarray) -> None:
