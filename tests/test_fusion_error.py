@@ -96,9 +96,10 @@ def test_the_attitude_loop_variance_matches_a_monte_carlo_of_the_pi_loop():
 def test_pos_std_between_fixes_tells_the_error(case):
     """Error over ``pos_std`` per axis, 100-300 s without a gap, on the first seed of each case of
     ``paper001.POS_STD_CASES`` (1 Hz and 10 Hz on the paper-001 set-up, the uncorrected
-    acceleration, the buoy). Measured RMS 0.89 / 0.88 / 0.99 (1 Hz), 0.89 / 0.80 / 1.00
-    (10 Hz), 0.84 / 1.05 / 1.27 uncorrected (east off by g·sin(roll), 14.5 cm RMS: without the
-    consistency check 14 there), 0.76 / 0.76 / 0.99 the buoy. Bounds RMS 0.7-1.3 and beyond 2
+    acceleration, the buoy, the held attitude). Measured RMS 0.89 / 0.88 / 0.99 (1 Hz), 0.89 /
+    0.80 / 1.00 (10 Hz), 0.84 / 1.05 / 1.27 uncorrected (east off by g·sin(roll), 14.5 cm RMS:
+    without the consistency check 14 there), 0.76 / 0.76 / 0.99 the buoy, 0.91 / 1.04 / 1.03
+    the held attitude (1.53 down before the rotation since the fix was modelled). Bounds RMS 0.7-1.3 and beyond 2
     at most 10 % of the time (Gaussian 4.6 %): the error is correlated over seconds to tens of
     seconds, so 200 s hold some twenty independent samples, whose RMS scatters by ±16 % (1σ)
     and the fraction beyond 2 by ±4.7 %. Until 2026-11-24 ``pos_std`` was the filter's own
@@ -147,13 +148,16 @@ def test_calibration_reads_z_as_stated():
     assert c["rms_z"][1] == 0.0 and c["rms_error_m"][0] == pytest.approx(math.sqrt(7.5))
 
 
-def test_state_round_trips_through_json_mid_gap():
+@pytest.mark.parametrize("propagation", ["gyro", "hold"])
+def test_state_round_trips_through_json_mid_gap(propagation):
     """get_state → JSON → set_state on a new estimator, 5 s into a GNSS dropout: the two then give
-    the same positions and ``pos_std`` to the last bit, through the gap and after it."""
+    the same positions and ``pos_std`` to the last bit, through the gap and after it (with a
+    held attitude the measured rate variance of its model goes along)."""
     rec = paper001.simulate(230.0, {"gnss.rate": 1.0, "gnss.dropout.start": 200.0, "gnss.dropout.duration": 20.0})
-    a = GnssAccFusion(paper001.params())
+    a = GnssAccFusion(paper001.params(propagation=propagation))
     run(a, rec, range(20500))
-    b = GnssAccFusion(paper001.params())
+    assert (a.error.rate_var is None) == (propagation == "gyro")
+    b = GnssAccFusion(paper001.params(propagation=propagation))
     b.set_state(json.loads(json.dumps(a.get_state())))
     rest = range(20500, len(rec["acc"]))
     out_a, out_b = run(a, rec, rest), run(b, rec, rest)
@@ -199,3 +203,38 @@ def test_the_attitude_pull_is_capped_only_after_a_gap():
     assert np.all(steady > pi_gains(1.0, 30.0)[0])
     assert pi_gains(30.0, 30.0)[0] == 1.0 and np.all(after_gap < 0.95) and after_gap[0] < 0.5
     np.testing.assert_allclose(after_gap, [0.463, 0.832, 0.927], atol=0.01)
+
+
+def test_the_held_attitude_grows_by_the_rotation_its_rate_model_says():
+    """``propagation="hold"``: between fixes ε integrates the vessel's rate ω, a Gauss-Markov
+    process (``loop_transition``). Started at ε = 0 with ω stationary, the covariance after 1 s
+    of 0.01 s steps must be the closed form rate variance × 2τ²(x − 1 + e^(−x)) (to 1 %, the
+    steps' first-order integration of ω), with the cross-axis covariance of the rate carried
+    as measured."""
+    rate = np.array([[4e-4, 1e-4, 0.0], [1e-4, 2e-4, 0.0], [0.0, 0.0, 1e-4]])
+    a, q = fusion_error.loop_transition(0.01, 5e-5, 50.0, 5e-5, False, rate)
+    p = np.zeros((9, 9))
+    p[3:6, 3:6] = rate
+    for _ in range(100):
+        p = a @ p @ a.T + q
+    expected = rate * fusion_error.held_rotation_var(1.0)
+    assert np.allclose(p[:3, :3], expected, rtol=0.01, atol=0.0), (p[:3, :3], expected)
+    assert np.allclose(p[3:6, 3:6], rate, rtol=1e-9)        # ω stays stationary
+    assert fusion_error.held_rotation_var(1e-3) == pytest.approx(1e-6, rel=1e-3)   # ≈ t² for t ≪ τ
+
+
+def test_the_held_attitude_measures_the_rate_from_fix_to_fix():
+    """``FusionError.held_rotation``: the rotation between consecutive fixes' attitudes, less
+    both fixes' noise, over the rotation variance per unit rate variance. A constant change c
+    over 1 s with fix noise s gives (c² − 2s²)/held_rotation_var(1) exactly; the gyro loop
+    ignores it."""
+    ant = np.array(paper001.ANT)
+    held = FusionError(ant, ant.mean(axis=0), 7e-4, 5e-5, (0.01, 0.015), 5e-5, 50.0, None)
+    change, std = np.array([0.02, -0.01, 0.003]), np.array([2e-3, 1e-3, 5e-4])
+    for _ in range(5):
+        held.held_rotation(change, 1.0, std)
+    expected = (np.outer(change, change) - 2 * np.diag(std**2)) / fusion_error.held_rotation_var(1.0)
+    assert np.allclose(held.rate_var, expected, rtol=1e-12)
+    gyro = error_model()
+    gyro.held_rotation(change, 1.0, std)
+    assert gyro.rate_var is None

@@ -75,6 +75,12 @@ from ..frames import GRAVITY_N
 NIS_MEMORY = 60.0
 #: Largest scale of the acceleration noise density the consistency check may reach.
 MAX_Q_SCALE = 1e8
+#: Correlation time of the vessel's angular rate in the held attitude's model [s]
+#: (``propagation="hold"``, :func:`loop_transition`).
+HOLD_RATE_TAU = 2.0
+#: Memory of the held attitude model's rate variance, measured from fix to fix [s]
+#: (:meth:`FusionError.held_rotation`).
+HOLD_RATE_MEMORY = 60.0
 
 
 def pi_gains(interval: float, tau: float) -> tuple[float, float]:
@@ -91,18 +97,35 @@ def skew(r: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
 
 
-def loop_transition(h: float, bias_sigma: float, bias_tau: float, gyro_noise: float, propagated: bool
-                    ) -> tuple[np.ndarray, np.ndarray]:
+def held_rotation_var(interval: float, tau: float = HOLD_RATE_TAU) -> float:
+    """Variance of the rotation ∫ω dt over ``interval`` s per unit variance of a Gauss-Markov
+    rate ω of correlation time ``tau`` [s²]: 2τ²(x − 1 + e^(−x)), x = interval/τ (≈ interval²
+    for interval ≪ τ)."""
+    x = interval / tau
+    return 2.0 * tau * tau * (x - 1.0 + math.exp(-x))
+
+
+def loop_transition(h: float, bias_sigma: float, bias_tau: float, gyro_noise: float, propagated: bool,
+                    rate_var: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Transition and noise of the attitude loop's error states over one sample of ``h`` s
     (module docstring, step 2), ordered (ε (3), β (3), b (3)), per NED axis alike.
 
     ε [rad] is the true minus the propagated attitude (true R = exp([ε]×) R̂), β = b − b̂ [rad/s]
     the gyro-bias error, b the true Gauss-Markov bias: ε̇ = −β − n (n the gyro's white noise,
     density ``gyro_noise`` [rad/s/√Hz]), b_{k+1} = φ b_k + w, b̂ constant between fixes. Not
-    ``propagated`` (``propagation="hold"``): ε is the held fix's, constant between fixes.
+    ``propagated`` (``propagation="hold"``): the attitude is the last fix's, held, so ε grows
+    by the vessel's rotation since: ε̇ = ω, the second three states are then the vessel's
+    angular rate ω [rad/s, NED], Gauss-Markov with correlation time :data:`HOLD_RATE_TAU` and
+    variance ``rate_var`` (None: not yet measured, ω held at zero), the last three unused.
     """
     if not propagated:
-        return np.eye(9), np.zeros((9, 9))
+        phi = math.exp(-h / HOLD_RATE_TAU)
+        a = np.kron(np.array([[1.0, HOLD_RATE_TAU * (1.0 - phi), 0.0], [0.0, phi, 0.0], [0.0, 0.0, 1.0]]), np.eye(3))
+        q = np.zeros((9, 9))
+        if rate_var is not None:
+            val, vec = np.linalg.eigh(rate_var)     # the measured covariance's nearest PSD matrix
+            q[3:6, 3:6] = (vec * np.maximum(val, 0.0)) @ vec.T * (1.0 - phi * phi)
+        return a, q
     phi = math.exp(-h / bias_tau)
     a = np.array([[1.0, -h, 0.0], [0.0, 1.0, phi - 1.0], [0.0, 0.0, phi]])
     q = np.zeros((3, 3))
@@ -162,6 +185,9 @@ class FusionError:
         self.model: tuple | None = None             # (Q_t's acceleration part, its bias part, the loop's noise)
         self.phi: np.ndarray | None = None          # the joint transition of one sample
         self.Q: np.ndarray | None = None            # the joint process noise of one sample
+        self.rate_var: np.ndarray | None = None     # held attitude: the vessel's rate variance [rad²/s², NED]
+        self.model_args: tuple | None = None        # set_model's arguments
+        self.held_fix = False                       # the last fix reset a held attitude's ε (fix)
 
     @property
     def P(self) -> np.ndarray | None:
@@ -208,7 +234,9 @@ class FusionError:
         ``g`` (eq. 15), ``q_acc`` eq. 16's Q with the density :attr:`q_true`
         (:func:`~.gnss_fusion.process_noise`), which the consistency check scales per axis, and
         ``q_bias`` the bias states' part."""
-        a, q_loop = loop_transition(dt, self.bias_sigma, self.bias_tau, self.gyro_noise, self.attitude_tau is not None)
+        self.model_args = (f, g, q_acc, q_bias, dt)
+        a, q_loop = loop_transition(dt, self.bias_sigma, self.bias_tau, self.gyro_noise, self.attitude_tau is not None,
+                                    self.rate_var)
         nx = len(f)
         phi = np.zeros((nx + 9, nx + 9))
         phi[:nx, :nx] = f
@@ -239,7 +267,23 @@ class FusionError:
         """S = [R̂ (l − c̄)]×: a fix's accelerometer point errs by S ε (:meth:`fix`)."""
         return skew(rot @ (self.acc_arm - self.mean_arm))
 
-    def fix(self, innovation: np.ndarray, k: np.ndarray, h: np.ndarray, interval: float, rot: np.ndarray) -> None:
+    def held_rotation(self, change: np.ndarray, interval: float, fix_attitude_std: np.ndarray) -> None:
+        """Held attitude (``attitude_tau`` None): measure the vessel's rate variance from the
+        rotation ``change`` [rad, NED rotation vector] between two fixes' attitudes ``interval``
+        s apart, each of standard deviations ``fix_attitude_std`` [rad]: E[change²] is the
+        rotation's variance (:func:`held_rotation_var` times the rate variance) plus both fixes'
+        noise. An exponential mean over :data:`HOLD_RATE_MEMORY` s; the model follows."""
+        if self.attitude_tau is not None or not 0.0 < interval <= 10.0 * HOLD_RATE_TAU:
+            return
+        change = np.asarray(change, dtype=float)
+        sample = (np.outer(change, change) - 2.0 * np.diag(np.square(fix_attitude_std))) / held_rotation_var(interval)
+        w = min(1.0, interval / HOLD_RATE_MEMORY)
+        self.rate_var = sample if self.rate_var is None else self.rate_var + w * (sample - self.rate_var)
+        if self.model_args is not None:
+            self.set_model(*self.model_args)
+
+    def fix(self, innovation: np.ndarray, k: np.ndarray, h: np.ndarray, interval: float, rot: np.ndarray,
+            held_std: np.ndarray | None = None) -> None:
         """A GNSS fix was taken with gain ``k`` (observation matrix ``h``) and ``innovation``
         z − H x⁻ [m], ``interval`` s after the previous one, its accelerometer point z the
         centroid plus the arm turned by the propagated attitude ``rot``: the consistency check
@@ -247,6 +291,13 @@ class FusionError:
 
         z − (true point) = n_c + (R̂ − R)(l − c̄) = n_c + S ε, so the innovation is
         ν = −H e + S ε + n_c and e ← (I − KH) e + K S ε + K n_c.
+
+        Held attitude (``attitude_tau`` None): ``rot`` is this fix's own attitude. Its error ε⁺
+        (standard deviations ``held_std`` [rad, NED]) is what the arm carries and what the held
+        attitude errs by from now on: ν = −H e + S ε⁺ + n_c, e ← (I − KH) e + K S ε⁺ + K n_c
+        and ε ← ε⁺ (:meth:`attitude_fix` then has nothing left to do). So the output's share
+        of ε⁺ is (K S − [R̂ l]×) ε⁺, about −[R̂ c̄]× ε⁺ once K is near 1: the arm from the
+        antennas' centroid, not the accelerometer's.
         """
         if self.joint is None:
             return
@@ -254,16 +305,27 @@ class FusionError:
         sa = self._fix_arm(rot)
         m = np.zeros((3, nx + 9))
         m[:, :nx] = -h
-        m[:, nx:nx + 3] = sa
-        s = np.einsum("ij,jk,ik->i", m, self.joint, m) + self.r_true
+        held = self.attitude_tau is None and held_std is not None
+        s2 = np.square(held_std) if held else np.zeros(3)
+        if not held:
+            m[:, nx:nx + 3] = sa
+        s = np.einsum("ij,jk,ik->i", m, self.joint, m) + self.r_true + np.einsum("ij,j,ij->i", sa, s2, sa)
         w = min(1.0, interval / NIS_MEMORY)
         ratio = np.square(innovation) / s           # 1 on average when the model holds
         self.q_scale = np.clip(self.q_scale * (1.0 + w * (ratio - 1.0)), 1.0, MAX_Q_SCALE)
         self._scale_noise()
         u = np.eye(nx + 9)
         u[:nx, :nx] -= k @ h
-        u[:nx, nx:nx + 3] = k @ sa
-        self.joint = u @ self.joint @ u.T
+        if held:
+            u[nx:nx + 3, nx:nx + 3] = 0.0
+            v = np.zeros((nx + 9, 3))
+            v[:nx] = k @ sa
+            v[nx:nx + 3] = np.eye(3)
+            self.joint = u @ self.joint @ u.T + (v * s2) @ v.T
+            self.held_fix = True
+        else:
+            u[:nx, nx:nx + 3] = k @ sa
+            self.joint = u @ self.joint @ u.T
         self.joint[:nx, :nx] += (k * self.r_true) @ k.T
 
     def attitude_gain(self, fix_attitude_std: np.ndarray) -> np.ndarray:
@@ -279,6 +341,9 @@ class FusionError:
         attitude error n, ε ← (1 − α) ε − α n and β ← β + k_i (ε + n); held
         (``attitude_tau`` None): ε ← −n."""
         if self.joint is None:
+            return
+        if self.held_fix:                           # fix() has reset ε with the same fix
+            self.held_fix = False
             return
         nx = len(self.joint) - 9
         s2 = np.square(fix_attitude_std)
@@ -314,10 +379,16 @@ class FusionError:
     # ---- state -------------------------------------------------------------------------------
     def get_state(self) -> dict:
         """JSON-serialisable state."""
-        return {"joint": None if self.joint is None else self.joint.tolist(), "q_scale": self.q_scale.tolist()}
+        return {"joint": None if self.joint is None else self.joint.tolist(), "q_scale": self.q_scale.tolist(),
+                "rate_var": None if self.rate_var is None else self.rate_var.tolist()}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
         self.joint = None if s["joint"] is None else np.array(s["joint"], dtype=float)
         self.q_scale = np.array(s["q_scale"], dtype=float)
-        self._scale_noise()
+        rate_var = s.get("rate_var")
+        self.rate_var = None if rate_var is None else np.array(rate_var, dtype=float)
+        if self.model_args is not None:             # the held attitude's model follows rate_var
+            self.set_model(*self.model_args)
+        else:
+            self._scale_noise()

@@ -563,10 +563,10 @@ class GnssAccFusion:
             return "rejected", f"GNSS epoch rejected: innovation {d:.1f} sigma > gate {p.gate}"
         self.kf.update(z, R=r_meas)
         since = min(self.since_fix, 1e9)
-        self.error.fix(y, self.kf.K, self.kf.H, since, rot_arm)
+        att_std = antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v)
+        self.error.fix(y, self.kf.K, self.kf.H, since, rot_arm, att_std if p.propagation == "hold" else None)
         if self.coaster is not None:
             self.coaster.anchor(z)
-        att_std = antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v)
         self._correct_attitude(sol.rot, since, att_std)
         if self.coast_attitude:
             rot_c, bias_c = quat_to_rot(self.q_coast), self.coast_bias.copy()
@@ -648,6 +648,7 @@ class GnssAccFusion:
         """
         p = self.params
         if p.propagation == "hold":
+            self.error.held_rotation(Rotation.from_matrix(rot_fix @ quat_to_rot(self.q).T).as_rotvec(), dt_fix, fix_std)
             self.q = Rotation.from_matrix(rot_fix).as_quat(scalar_first=True)
             self.error.attitude_fix(fix_std, dt_fix)
             return

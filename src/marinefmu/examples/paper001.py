@@ -329,6 +329,7 @@ POS_STD_CASES = {
     "10 Hz": (10.0, (1, 2, 3), {}, "tilting"),
     "uncorrected, 1 Hz": (1.0, (1, 2, 3), {"attitude_correction": False, "gate": math.inf}, "tilting"),
     "buoy, 1 Hz": (1.0, (1, 2, 3), {}, "buoy"),
+    "held attitude, 1 Hz": (1.0, (1, 2, 3), {"propagation": "hold"}, "tilting"),
 }
 
 
