@@ -97,10 +97,11 @@ def skew(r: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
 
 
-def held_rotation_var(interval: float, tau: float = HOLD_RATE_TAU) -> float:
+def held_rotation_var(interval: float, tau: float | None = None) -> float:
     """Variance of the rotation ∫ω dt over ``interval`` s per unit variance of a Gauss-Markov
-    rate ω of correlation time ``tau`` [s²]: 2τ²(x − 1 + e^(−x)), x = interval/τ (≈ interval²
-    for interval ≪ τ)."""
+    rate ω of correlation time ``tau`` [s] (None: :data:`HOLD_RATE_TAU`) [s²]:
+    2τ²(x − 1 + e^(−x)), x = interval/τ (≈ interval² for interval ≪ τ)."""
+    tau = HOLD_RATE_TAU if tau is None else tau
     x = interval / tau
     return 2.0 * tau * tau * (x - 1.0 + math.exp(-x))
 
@@ -282,6 +283,23 @@ class FusionError:
         if self.model_args is not None:
             self.set_model(*self.model_args)
 
+    def innovation_var(self, h: np.ndarray, rot: np.ndarray, held_std: np.ndarray | None = None) -> np.ndarray:
+        """(3,) variance per NED axis of a fix's innovation z − H x⁻ [m²] as this covariance
+        predicts it (:meth:`fix`: ν = −H e + S ε + n_c, or with a held attitude −H e + S ε⁺ +
+        n_c); zeros before the first fix."""
+        if self.joint is None:
+            return np.zeros(3)
+        nx = len(self.joint) - 9
+        sa = self._fix_arm(rot)
+        m = np.zeros((3, nx + 9))
+        m[:, :nx] = -h
+        s2 = np.zeros(3)
+        if self.attitude_tau is None and held_std is not None:
+            s2 = np.square(held_std)
+        else:
+            m[:, nx:nx + 3] = sa
+        return np.einsum("ij,jk,ik->i", m, self.joint, m) + self.r_true + np.einsum("ij,j,ij->i", sa, s2, sa)
+
     def fix(self, innovation: np.ndarray, k: np.ndarray, h: np.ndarray, interval: float, rot: np.ndarray,
             held_std: np.ndarray | None = None) -> None:
         """A GNSS fix was taken with gain ``k`` (observation matrix ``h``) and ``innovation``
@@ -303,13 +321,9 @@ class FusionError:
             return
         nx = len(k)
         sa = self._fix_arm(rot)
-        m = np.zeros((3, nx + 9))
-        m[:, :nx] = -h
         held = self.attitude_tau is None and held_std is not None
         s2 = np.square(held_std) if held else np.zeros(3)
-        if not held:
-            m[:, nx:nx + 3] = sa
-        s = np.einsum("ij,jk,ik->i", m, self.joint, m) + self.r_true + np.einsum("ij,j,ij->i", sa, s2, sa)
+        s = self.innovation_var(h, rot, held_std)
         w = min(1.0, interval / NIS_MEMORY)
         ratio = np.square(innovation) / s           # 1 on average when the model holds
         self.q_scale = np.clip(self.q_scale * (1.0 + w * (ratio - 1.0)), 1.0, MAX_Q_SCALE)

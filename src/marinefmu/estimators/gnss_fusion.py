@@ -552,8 +552,14 @@ class GnssAccFusion:
             self.kf.P[:3, :3] += np.diag(self.coast_var)
             self.coast_var = self.coast_track = None
             self.error.follow(self.kf.P)
+        att_std = antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v)
+        held_std = att_std if p.propagation == "hold" else None
         y = z - self.kf.H @ self.kf.x.ravel()
         s = self.kf.H @ self.kf.P @ self.kf.H.T + r_meas
+        # the gate weighs the innovation against at least the size that the error's covariance
+        # expects: the filter's own does not know the rotation since the fix of a held attitude
+        # (module docstring)
+        s[np.diag_indices(3)] = np.maximum(np.diag(s), self.error.innovation_var(self.kf.H, rot_arm, held_std))
         d = math.sqrt(float(y @ np.linalg.solve(s, y)))
         if d > p.gate:
             self.rejecting += gap
@@ -563,8 +569,7 @@ class GnssAccFusion:
             return "rejected", f"GNSS epoch rejected: innovation {d:.1f} sigma > gate {p.gate}"
         self.kf.update(z, R=r_meas)
         since = min(self.since_fix, 1e9)
-        att_std = antenna_attitude_std(p.arms, sol.rot, p.antenna_sigma_h, p.antenna_sigma_v)
-        self.error.fix(y, self.kf.K, self.kf.H, since, rot_arm, att_std if p.propagation == "hold" else None)
+        self.error.fix(y, self.kf.K, self.kf.H, since, rot_arm, held_std)
         if self.coaster is not None:
             self.coaster.anchor(z)
         self._correct_attitude(sol.rot, since, att_std)
