@@ -22,14 +22,23 @@ kept at the accelerometer rate:
    gyro-bias error and the true Gauss-Markov bias (``gyro_bias_sigma``, ``gyro_bias_tau``) —
    driven by the gyro's angle random walk ``gyro_noise`` and pulled at each fix with the PI
    loop's gains (:func:`~.gnss_fusion.pi_pull`) and the fix attitude's noise
-   (:func:`~.antenna_attitude.antenna_attitude_std`). With ``propagation="hold"`` ε is the
-   held fix's attitude noise, reset after each fix's position update. The real error of a
-   held attitude is mostly the vessel's rotation since the fix, which this model does not
-   know: on the paper-001 set-up at 1 Hz (seed 1, 100-300 s, a scan) the errors are 0.9 /
-   5.9 / 2.8 cm N / E / D and error / ``pos_std`` 0.96 / 1.13 / 1.53, the consistency check
-   (step 4) covering part of it. Taking the new fix's noise into the update instead, which
-   is what z holds, read 0.91 / 1.11 / 2.38 (seed 1) and 0.98 / 1.25 / 2.64 (seed 2): no
-   better (down further from 1: the rotation since the fix dominates), so not done.
+   (:func:`~.antenna_attitude.antenna_attitude_std`).
+
+   With ``propagation="hold"`` the attitude is the last fix's, and its error is that fix's
+   attitude noise ε⁺ plus the vessel's rotation since: ε̇ = ω, with ω, the vessel's angular
+   rate, a Gauss-Markov process of correlation time :data:`HOLD_RATE_TAU` in place of
+   (β, b). Its covariance is measured from fix to fix (:meth:`FusionError.held_rotation`: the
+   rotation between consecutive fixes' attitudes, less their noise). Each fix resets ε to ε⁺,
+   which is also what the fix's accelerometer point carries over its arm (:meth:`FusionError.fix`),
+   so the output's share of ε⁺ is over the short arm from the antennas' centroid. Until
+   2026-11-24 (session 27) ε was ε⁺ alone, held constant: on the paper-001 set-up at 1 Hz
+   (seeds 1-3, 100-300 s, ``make bench``, part ``pos_std``) error / ``pos_std`` was
+   0.96-1.09 / 1.13-1.27 / 1.43-1.70 N / E / D, over-confident, the consistency check
+   (step 4) covering part of the rotation's effect; now 0.91-1.03 / 1.04-1.13 / 0.98-1.09.
+   East depends on :data:`HOLD_RATE_TAU` (seeds 1-2, a scan): 0.84-0.91 with 0.7 s, 0.95-1.03
+   with 1.3 s (about 1/ω_p of the Tp 8 s sea), 1.04-1.13 with 2 s, 1.20-1.31 with 4 s,
+   1.36-1.50 with 10 s. 2 s is kept for longer seas too: near the roll resonance (Tp 12 s,
+   roll 4.6° RMS) seed 1 reads 0.91 / 0.77 / 0.88, east 0.69 with 1.3 s and 0.92 with 4 s.
 3. **How the two go together** (the reason for one covariance). An attitude error moves
    (a) the acceleration the filter integrates, u − a = (R̂ − R) f_b = [R̂ f_b]× ε ≈ −[g_n]× ε
    (east −g ε_N, north g ε_E; with ``attitude_correction`` only), (b) the accelerometer point
