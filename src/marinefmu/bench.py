@@ -291,7 +291,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     what they measure; return the whole file's data.
 
     ``speed`` takes a few minutes, ``heave`` about twenty (seven seas with their causal bounds, the ``band_min`` and ``window_max`` studies), ``peer`` about one, ``orcaflex`` a
-    few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 60 GNSS dropouts of 30 s 4.5-6.7 min into a run, the same 60 another 15 min later, and 4 of 5 min, real time and RTS-smoothed, and the best linear estimator's errors through the first 60, :func:`~.examples.gap_bound.gap_bound`) about thirty, ``pos_std`` (:func:`~.examples.paper001.pos_std_between_fixes`, the fusion's ``pos_std`` against its error away from gaps, 19 runs of 300 s) a few minutes, ``system`` (three seas, three engines, do-nothing FMUs and a 3-hour run) about half an hour,
+    few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 60 GNSS dropouts of 30 s 4.5-6.7 min into a run, the same 60 another 15 min later, and 4 of 5 min, real time and RTS-smoothed, and the best linear estimator's errors through the first 60, :func:`~.examples.gap_bound.gap_bound`) about thirty, ``pos_std`` (:func:`~.examples.paper001.pos_std_between_fixes`, the fusion's ``pos_std`` against its error away from gaps, 22 runs of 300 s) a few minutes, ``system`` (three seas, three engines, do-nothing FMUs and a 3-hour run) about half an hour,
     ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
     2-core machine."""
     from .cosim.build import build_all, repo_root
