@@ -99,9 +99,9 @@ def test_pos_std_between_fixes_tells_the_error(case):
     acceleration, the buoy, the held attitude). Measured RMS 0.89 / 0.88 / 0.99 (1 Hz), 0.89 /
     0.80 / 1.00 (10 Hz), 0.84 / 1.05 / 1.27 uncorrected (east off by g·sin(roll), 14.5 cm RMS:
     without the consistency check 14 there), 0.76 / 0.76 / 0.99 the buoy, 0.91 / 1.04 / 1.03
-    the held attitude (1.53 down before the rotation since the fix was modelled). Bounds RMS 0.7-1.3 and beyond 2
-    at most 10 % of the time (Gaussian 4.6 %): the error is correlated over seconds to tens of
-    seconds, so 200 s hold some twenty independent samples, whose RMS scatters by ±16 % (1σ)
+    the held attitude (1.53 down before the rotation since the fix was modelled, session 27).
+    Bounds RMS 0.7-1.3 and beyond 2 at most 10 % of the time (Gaussian 4.6 %): the error is
+    correlated over seconds to tens of seconds, so 200 s hold some twenty independent samples, whose RMS scatters by ±16 % (1σ)
     and the fraction beyond 2 by ±4.7 %. Until 2026-11-24 ``pos_std`` was the filter's own
     covariance, 3-8.5 cm on errors of 0.7 cm: RMS 0.13-0.19 at 1 Hz; until 2026-11-24 (session
     26) the attitude's share was added as independent of the position error: 0.76 / 0.73 at
