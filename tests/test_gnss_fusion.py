@@ -143,7 +143,9 @@ def test_a_held_attitude_coasts_a_dropout_on_the_gyro():
     the gap 1.4 / 8.2 / 1.9 cm (bound 15 cm; the gyro mode's 1.2 / 6.1 / 3.0 cm); valid
     throughout. Before the first missed epoch the error is the held attitude's, as between
     any two fixes (34 cm east at 0.98 s here). When the held attitude stayed through the gap,
-    east was 5.7 m off, flagged valid, at 8.5 ``pos_std``."""
+    east was 5.7 m off, flagged valid, at 8.5 ``pos_std``. Without a gyro nothing follows the
+    attitude: the output is finite but not valid from the first overdue fix (0.49 s into the
+    gap here) until GNSS returns, and valid throughout the 200 s before."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
                                     "sea.seed": 1, "sensors.seed": 1})
     r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(propagation="hold"),
@@ -152,6 +154,10 @@ def test_a_held_attitude_coasts_a_dropout_on_the_gyro():
     coasted = slice(int(301.5 / paper001.DT), gap.stop)
     assert np.all(r["valid"][gap]) and np.sum(r["fix"][gap] == "wave") >= 279
     assert np.all(np.max(np.abs(r["pos"][coasted] - rec["cog"][coasted]), axis=0) < 0.15)
+    blind = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], None, paper001.params(propagation="hold"),
+                 gnss_valid=rec["gnss_valid"])
+    assert np.all(np.isfinite(blind["pos"])) and np.all(blind["valid"][int(100.0 / paper001.DT):gap.start])
+    assert not np.any(blind["valid"][int(300.5 / paper001.DT):gap.stop - 1])
 
 
 def test_paper_mode_equals_a_plain_filterpy_run_of_eqs_13_to_19():

@@ -22,7 +22,8 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    (:data:`HOLD_OVERDUE` times the usual interval) and a gyro is given, it takes the wave
    coast's gyro attitude until the next fix: a held attitude is stale in a gap (through the
    30 s dropout of the README, seed 1, it left east 5.7 m off; now 8.2 cm from 1.5 s in,
-   against 6.1 cm with ``"gyro"``).
+   against 6.1 cm with ``"gyro"``). Without a gyro nothing can follow the attitude in a gap:
+   ``valid`` is false while a fix is overdue.
 3. **Kalman fusion** (filterpy ``KalmanFilter``): per axis the constant-acceleration model of
    eqs. 13-19, x = [d, v], Φ = [[1, Δt], [0, 1]], G = [Δt²/2, Δt], u = a_n,
    Q = q·[[Δt³/3, Δt²/2], [Δt²/2, Δt]] (eq. 16), R = r/Δt (eq. 17), Δt the accelerometer
@@ -528,7 +529,8 @@ class GnssAccFusion:
             fix = "wave"
         # a refused epoch (bad coordinates, poor fit, gated outlier) is a bad sample like a bad
         # accelerometer one: the output coasts and is flagged for that step
-        valid = good and fix not in ("skipped", "rejected") and self.initialised and self.since_fix <= p.max_coast
+        valid = (good and fix not in ("skipped", "rejected") and self.initialised and self.since_fix <= p.max_coast
+                 and not self._stale_attitude())
         return self._result(fix, valid, warning, w)
 
     def _epoch(self, gnss: Any, dt: float) -> tuple[str, str | None]:
@@ -610,6 +612,15 @@ class GnssAccFusion:
         """The coast corrects its acceleration with its own gyro attitude (a correction, a band
         coast, and a gyro sample seen)."""
         return self.coast_attitude and self.last_gyro is not None
+
+    def _stale_attitude(self) -> bool:
+        """A held attitude with no fix to hold and no gyro to follow (module docstring, item 2):
+        the acceleration is then turned by an attitude that the vessel has left, and the
+        output is not valid. The wave coast still bounds the drift (seed 1's 30 s dropout:
+        6.3 m east, against 186 m without it), but neither it nor ``pos_std`` knows the
+        attitude's error then."""
+        return (self.params.propagation == "hold" and self.last_gyro is None
+                and self.since_fix > HOLD_OVERDUE * self.fix_interval)
 
     def _holding(self) -> bool:
         """No accepted fix and no pseudo-fix for ``max_coast`` s: the position is held (an
