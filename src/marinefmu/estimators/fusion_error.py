@@ -39,6 +39,9 @@ kept at the accelerometer rate:
    with 1.3 s (about 1/ω_p of the Tp 8 s sea), 1.04-1.13 with 2 s, 1.20-1.31 with 4 s,
    1.36-1.50 with 10 s. 2 s is kept for longer seas too: near the roll resonance (Tp 12 s,
    roll 4.6° RMS) seed 1 reads 0.91 / 0.77 / 0.88, east 0.69 with 1.3 s and 0.92 with 4 s.
+   Once a fix is overdue the fusion follows its coast's gyro attitude (:mod:`.gnss_fusion`);
+   this model still takes the attitude as held, so it is cautious then, and in a gap
+   ``pos_std`` is the coast's anyway.
 3. **How the two go together** (the reason for one covariance). An attitude error moves
    (a) the acceleration the filter integrates, u − a = (R̂ − R) f_b = [R̂ f_b]× ε ≈ −[g_n]× ε
    (east −g ε_N, north g ε_E; with ``attitude_correction`` only), (b) the accelerometer point
@@ -362,7 +365,8 @@ class FusionError:
         ``fix_attitude_std`` [rad, NED], ``interval`` s after the previous pull, with the
         proportional gains ``alpha`` per axis (None: the PI's, :func:`pi_gains`): with the fix's
         attitude error n, ε ← (1 − α) ε − α n and β ← β + k_i (ε + n); held
-        (``attitude_tau`` None): ε ← −n."""
+        (``attitude_tau`` None): ε ← −n, unless :meth:`fix` has already reset ε with the same
+        fix (it does when given the fix's attitude std)."""
         if self.joint is None:
             return
         if self.held_fix:                           # fix() has reset ε with the same fix
