@@ -22,8 +22,9 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    (:data:`HOLD_OVERDUE` times the usual interval) and a gyro is given, it takes the wave
    coast's gyro attitude until the next fix: a held attitude is stale in a gap (through the
    30 s dropout of the README, seed 1, it left east 5.7 m off; now 8.2 cm from 1.5 s in,
-   against 6.1 cm with ``"gyro"``). Without a gyro nothing can follow the attitude in a gap:
-   ``valid`` is false while a fix is overdue.
+   against 6.1 cm with ``"gyro"``). Without a gyro (or with ``coast="inertial"``, which keeps
+   no gyro attitude) nothing follows the attitude in a gap: ``valid`` is false while a fix is
+   overdue.
 3. **Kalman fusion** (filterpy ``KalmanFilter``): per axis the constant-acceleration model of
    eqs. 13-19, x = [d, v], Φ = [[1, Δt], [0, 1]], G = [Δt²/2, Δt], u = a_n,
    Q = q·[[Δt³/3, Δt²/2], [Δt²/2, Δt]] (eq. 16), R = r/Δt (eq. 17), Δt the accelerometer
@@ -614,12 +615,13 @@ class GnssAccFusion:
         return self.coast_attitude and self.last_gyro is not None
 
     def _stale_attitude(self) -> bool:
-        """A held attitude with no fix to hold and no gyro to follow (module docstring, item 2):
-        the acceleration is then turned by an attitude that the vessel has left, and the
-        output is not valid. The wave coast still bounds the drift (seed 1's 30 s dropout:
-        6.3 m east, against 186 m without it), but neither it nor ``pos_std`` knows the
-        attitude's error then."""
-        return (self.params.propagation == "hold" and self.last_gyro is None
+        """A held attitude with no fix to hold and no gyro attitude to follow (no gyro, or no
+        band coast to keep one; module docstring, item 2): the acceleration is then turned by
+        an attitude that the vessel has left, and the output is not valid. The wave coast
+        still bounds the drift (seed 1's 30 s dropout without a gyro: 6.3 m east, against
+        186 m without the coast), but neither it nor ``pos_std`` knows the attitude's error
+        then."""
+        return (self.params.propagation == "hold" and not self._coast_gyro()
                 and self.since_fix > HOLD_OVERDUE * self.fix_interval)
 
     def _holding(self) -> bool:
