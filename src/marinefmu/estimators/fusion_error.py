@@ -32,9 +32,9 @@ kept at the accelerometer rate:
    which is also what the fix's accelerometer point carries over its arm (:meth:`FusionError.fix`),
    so the output's share of ε⁺ is over the short arm from the antennas' centroid. Until
    2026-11-24 (session 27) ε was ε⁺ alone, held constant: on the paper-001 set-up at 1 Hz
-   (seeds 1-3, 100-300 s, ``make bench``, part ``pos_std``) error / ``pos_std`` was
-   0.96-1.09 / 1.13-1.27 / 1.43-1.70 N / E / D, over-confident, the consistency check
-   (step 4) covering part of the rotation's effect; now 0.91-1.03 / 1.04-1.13 / 0.98-1.09.
+   (seeds 1-3, 100-300 s, a scan) error / ``pos_std`` was 0.96-1.09 / 1.13-1.27 / 1.43-1.70
+   N / E / D, over-confident, the consistency check (step 4) covering part of the rotation's
+   effect; now 0.91-1.03 / 1.04-1.13 / 0.98-1.09 (``make bench``, part ``pos_std``).
    East depends on :data:`HOLD_RATE_TAU` (seeds 1-2, a scan): 0.84-0.91 with 0.7 s, 0.95-1.03
    with 1.3 s (about 1/ω_p of the Tp 8 s sea), 1.04-1.13 with 2 s, 1.20-1.31 with 4 s,
    1.36-1.50 with 10 s. 2 s is kept for longer seas too: near the roll resonance (Tp 12 s,
