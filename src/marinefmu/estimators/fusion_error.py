@@ -200,7 +200,6 @@ class FusionError:
         self.Q: np.ndarray | None = None            # the joint process noise of one sample
         self.rate_var: np.ndarray | None = None     # held attitude: the vessel's rate variance [rad²/s², NED]
         self.model_args: tuple | None = None        # set_model's arguments
-        self.held_fix = False                       # the last fix reset a held attitude's ε (fix)
 
     @property
     def P(self) -> np.ndarray | None:
@@ -313,7 +312,7 @@ class FusionError:
         return np.einsum("ij,jk,ik->i", m, self.joint, m) + self.r_true + np.einsum("ij,j,ij->i", sa, s2, sa)
 
     def fix(self, innovation: np.ndarray, k: np.ndarray, h: np.ndarray, interval: float, rot: np.ndarray,
-            held_std: np.ndarray | None = None) -> None:
+            held_std: np.ndarray | None = None, predicted: np.ndarray | None = None) -> None:
         """A GNSS fix was taken with gain ``k`` (observation matrix ``h``) and ``innovation``
         z − H x⁻ [m], ``interval`` s after the previous one, its accelerometer point z the
         centroid plus the arm turned by the propagated attitude ``rot``: the consistency check
@@ -325,9 +324,12 @@ class FusionError:
         Held attitude (``attitude_tau`` None): ``rot`` is this fix's own attitude. Its error ε⁺
         (standard deviations ``held_std`` [rad, NED]) is what the arm carries and what the held
         attitude errs by from now on: ν = −H e + S ε⁺ + n_c, e ← (I − KH) e + K S ε⁺ + K n_c
-        and ε ← ε⁺ (:meth:`attitude_fix` then has nothing left to do). So the output's share
+        and ε ← ε⁺ (so :meth:`attitude_fix` is not called for it). So the output's share
         of ε⁺ is (K S − [R̂ l]×) ε⁺, about −[R̂ c̄]× ε⁺ once K is near 1: the arm from the
         antennas' centroid, not the accelerometer's.
+
+        ``predicted``: :meth:`innovation_var` for this fix, if the caller has it already (the
+        fusion's gate does).
         """
         if self.joint is None:
             return
@@ -335,7 +337,7 @@ class FusionError:
         sa = self._fix_arm(rot)
         held = self.attitude_tau is None and held_std is not None
         s2 = np.square(held_std) if held else np.zeros(3)
-        s = self.innovation_var(h, rot, held_std)
+        s = self.innovation_var(h, rot, held_std) if predicted is None else predicted
         w = min(1.0, interval / NIS_MEMORY)
         ratio = np.square(innovation) / s           # 1 on average when the model holds
         self.q_scale = np.clip(self.q_scale * (1.0 + w * (ratio - 1.0)), 1.0, MAX_Q_SCALE)
@@ -348,7 +350,6 @@ class FusionError:
             v[:nx] = k @ sa
             v[nx:nx + 3] = np.eye(3)
             self.joint = u @ self.joint @ u.T + (v * s2) @ v.T
-            self.held_fix = True
         else:
             u[:nx, nx:nx + 3] = k @ sa
             self.joint = u @ self.joint @ u.T
@@ -365,12 +366,9 @@ class FusionError:
         ``fix_attitude_std`` [rad, NED], ``interval`` s after the previous pull, with the
         proportional gains ``alpha`` per axis (None: the PI's, :func:`pi_gains`): with the fix's
         attitude error n, ε ← (1 − α) ε − α n and β ← β + k_i (ε + n); held
-        (``attitude_tau`` None): ε ← −n, unless :meth:`fix` has already reset ε with the same
-        fix (it does when given the fix's attitude std)."""
+        (``attitude_tau`` None): ε ← −n (for a fix that :meth:`fix` took with its attitude std,
+        which resets ε itself, not called)."""
         if self.joint is None:
-            return
-        if self.held_fix:                           # fix() has reset ε with the same fix
-            self.held_fix = False
             return
         nx = len(self.joint) - 9
         s2 = np.square(fix_attitude_std)

@@ -580,7 +580,8 @@ class GnssAccFusion:
         # the gate weighs the innovation against at least the size that the error's covariance
         # expects: the filter's own does not know the rotation since the fix of a held attitude
         # (module docstring, item 3)
-        s[np.diag_indices(3)] = np.maximum(np.diag(s), self.error.innovation_var(self.kf.H, rot_arm, held_std))
+        expected = self.error.innovation_var(self.kf.H, rot_arm, held_std)
+        s[np.diag_indices(3)] = np.maximum(np.diag(s), expected)
         d = math.sqrt(float(y @ np.linalg.solve(s, y)))
         if d > p.gate:
             self.rejecting += gap
@@ -590,7 +591,7 @@ class GnssAccFusion:
             return "rejected", f"GNSS epoch rejected: innovation {d:.1f} sigma > gate {p.gate}"
         self.kf.update(z, R=r_meas)
         since = min(self.since_fix, 1e9)
-        self.error.fix(y, self.kf.K, self.kf.H, since, rot_arm, held_std)
+        self.error.fix(y, self.kf.K, self.kf.H, since, rot_arm, held_std, expected)
         if self.coaster is not None:
             self.coaster.anchor(z)
         self._correct_attitude(sol.rot, since, att_std)
@@ -694,8 +695,7 @@ class GnssAccFusion:
             if dt_fix <= HOLD_OVERDUE * self.fix_interval:     # held since the last fix (not the gyro's)
                 self.error.held_rotation(Rotation.from_matrix(rot_fix @ quat_to_rot(self.q).T).as_rotvec(), dt_fix, fix_std)
             self.q = Rotation.from_matrix(rot_fix).as_quat(scalar_first=True)
-            self.error.attitude_fix(fix_std, dt_fix)
-            return
+            return      # the error's ε was reset with the fix's position (FusionError.fix)
         alpha = np.minimum(pi_gains(dt_fix, p.attitude_tau)[0], self.error.attitude_gain(fix_std))
         self.q, self.gyro_bias = pi_pull(self.q, self.gyro_bias, rot_fix, dt_fix, p.attitude_tau, alpha)
         self.error.attitude_fix(fix_std, dt_fix, alpha)
