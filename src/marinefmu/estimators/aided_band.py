@@ -106,7 +106,7 @@ follow ε with a bandwidth of about 0.37 rad/s, so what the band model misses at
 partly lands in ε. Measured and not taken
 before the tilt states: lower offset noise, an offset-rate state, another offset noise in gaps
 only, a smoothed spectrum, and the fixes' attitude as a measurement of the offset itself
-(README, paper 001).
+(``docs/paper001_dropout.md``).
 """
 from __future__ import annotations
 
@@ -276,7 +276,7 @@ class AidedBand:
         averaged its argument, a block mean of five 100 Hz samples, with the previous one, as
         the heave observer does with point samples: the band states then lagged 20 ms more
         (measured on a sine: 31.4 ms against the model's own 11.4 ms; 1.6 % of the sway at
-        0.8 rad/s), half of the coast's error with perfect sensors (README, paper 001).
+        0.8 rad/s), half of the coast's error with perfect sensors (``docs/paper001_dropout.md``).
         """
         if self.model is None:
             self._predict(0.0)

@@ -192,7 +192,7 @@ class FusionParams:
         400 s × seeds 11-20): over 10 cm in 5 with the fusion's 30 s (mean 7.3 cm, worst
         13.7 cm), 2 with 60 s and 90 s, 1 with 150 s (6.8 cm, 10.6 cm), 300 s (6.8 cm, 10.1 cm)
         and 1000 s (6.9 cm, 10.7 cm). The fusion's own 60 s would coast as well but
-        makes the fused output worse all the time (README, paper 001). [``coast_attitude_tau``]
+        makes the fused output worse all the time (``docs/paper001_dropout.md``). [``coast_attitude_tau``]
     coast_window : float
         Memory of the drift model of ``coast="band"`` (:func:`~.aided_band.drift_noise`) [s],
         10 … 3600. The coast gives pseudo-fixes until GNSS returns, however long the gap (until
@@ -684,8 +684,8 @@ class GnssAccFusion:
         steady rate the PI's own is the smaller (1 Hz, τ 30 s: 0.067 against 0.1-0.6), so
         nothing changes there; after a gap of τ/2 or more the PI's is 1, which hands the fix's
         attitude noise (1.9 mrad about N on the paper-001 set-up, 1.9 cm at the COG over the 10 m
-        arm) to the output whole. Over the ten hardest dropouts of the README the largest east
-        error in the 5 s after the gap fell from 1.6-7.6 cm (mean 3.9) to 1.2-6.0 cm (mean 3.2),
+        arm) to the output whole. Over the ten hardest dropouts (``docs/paper001_dropout.md``)
+        the largest east error in the 5 s after the gap fell from 1.6-7.6 cm (mean 3.9) to 1.2-6.0 cm (mean 3.2),
         and in the 25 s after those from 2.0-3.9 (2.7) to 1.9-3.1 cm (2.3), down in the first
         5 s from 2.6 to 2.3 cm on average; before the gaps nothing changed, and in them at most
         0.1 cm, where a skipped epoch had doubled an interval (a scan, 2026-11-24).

@@ -24,7 +24,7 @@ is why it does much better than the per-axis wave model. It estimates the best l
 estimator's error from above (finite memory and training, 4 Hz block means). An estimator that
 must learn the statistics in service cannot expect to reach it: refitted on the few minutes of
 fixes before each gap, the same fit errs 12.7 cm on average (30 s memory, 1 Hz) and 22.5 cm
-(60 s) over the 60 dropouts (a scan, README). So it shows the goal within reach in principle,
+(60 s) over the 60 dropouts (a scan, ``docs/paper001_dropout.md``). So it shows the goal within reach in principle,
 and where the information is; it is not a floor that explains the wave coast's errors.
 
 Hand-written normal equations (numpy), as in :func:`~marinefmu.examples.paper003.causal_bound`:
