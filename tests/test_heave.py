@@ -15,7 +15,8 @@ from marinefmu.estimators.heave import (
     HeaveObserver, HeaveObserverParams, point_heave, vertical_acceleration,
 )
 from marinefmu.estimators.highpass_heave import heave_estimator
-from marinefmu.estimators.band_bank import band_elements, band_grid, build_band_bank, discretise, resonator
+from marinefmu.estimators.band_bank import (band_elements, band_grid, build_band_bank, discretise, resonator,
+                                            smooth_densities)
 from marinefmu.estimators.oscillator_bank import build_bank, carry_map, mode_noise_covariance, mode_transition
 from marinefmu.frames import G, body_to_euler_rates
 from marinefmu.estimators.wave_peaks import Spectrum
@@ -213,6 +214,33 @@ def test_band_elements_integrate_the_heave_spectrum_over_their_bands():
     inside = s_z > 0                                   # the end elements at 0.3 and 1.2 rad/s read zero
     np.testing.assert_allclose(w, grid[inside], rtol=1e-12)
     np.testing.assert_allclose(var, (s_z * np.gradient(grid))[inside], rtol=1e-12)
+
+
+def test_smoothed_band_densities_keep_the_variance_and_do_not_spill_past_a_band_edge():
+    """The log-domain smoothing (``band_smoothing``) fills a one-element dip from its
+    neighbours, keeps Σ density·width (the window's heave variance), leaves a smooth spectrum
+    alone, and, unlike an arithmetic mean, moves next to nothing across a steep band edge (the
+    element on the edge's high side falls instead, by the same geometric weights)."""
+    width = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    dip = np.array([1.0, 1.0, 0.1, 1.0, 1.0, 1.0])
+    out = smooth_densities(dip, width, 1)
+    assert np.sum(out * width) == pytest.approx(np.sum(dip * width), rel=1e-12)
+    # geometric 1-2-1 weights: log10 of the dip's row, 0 0 -1 0 0 0, becomes 0 -¼ -½ -¼ 0 0
+    np.testing.assert_allclose(out / out[0], 10.0 ** -np.array([0, 0.25, 0.5, 0.25, 0, 0]), rtol=1e-12)
+    flat = np.full(6, 2.5)
+    np.testing.assert_allclose(smooth_densities(flat, width, 2), flat, rtol=1e-12)
+    np.testing.assert_array_equal(smooth_densities(dip, width, 0), dip)
+    edge = np.array([1e-8, 1e-8, 1e-6, 1.0, 1.0, 1.0])    # the sea starts at the fourth element
+    out = smooth_densities(edge, width, 1)
+    assert out[2] < 1e-4 * out[4]                         # arithmetic 1-2-1: a quarter of it
+    # in band_elements the smoothed densities give the elements' variances, before the floor
+    omega = 0.01 * np.arange(1, 301)
+    acc = np.where((omega > 0.5) & (omega < 1.0), omega ** 4, 0.0)
+    grid = band_grid(0.3, 1.2, 9)
+    spectrum = Spectrum(omega, acc, acc, acc, acc)
+    _, v0 = band_elements(spectrum, grid, 0.0)
+    _, v1 = band_elements(spectrum, grid, 0.0, smoothing=1)
+    assert v1.sum() == pytest.approx(v0.sum(), rel=1e-12)     # before the floor: all of it
 
 
 def test_spectrum_window_grows_with_the_data_up_to_window_max():
@@ -465,6 +493,8 @@ def test_bad_samples_coast_and_are_reported():
     ("window", 20.0, "window = 20.0 is out of range"),
     ("window_max", 100.0, "window_max = 100.0 is out of range"),
     ("band_variance", "mean", "band_variance = 'mean' is not allowed"),
+    ("band_smoothing", 6, "band_smoothing = 6 is out of range"),
+    ("band_smoothing", -1, "band_smoothing = -1 is out of range"),
     ("max_modes", 0, "max_modes = 0 is out of range"),
     ("acc_noise", 0.0, "acc_noise = 0.0 is out of range"),
     ("mode_noise", -1.0, "mode_noise = -1.0 is out of range"),

@@ -174,6 +174,10 @@ class HeaveObserverParams:
         ``"integral"`` (default: the heave spectrum integrated over each element's band) or
         ``"point"`` (read at the element's frequency, as until 2026-11-23),
         :func:`~.band_bank.band_elements`. [``band_variance``]
+    band_smoothing : int
+        Half-width of the smoothing of the band elements' heave densities over their
+        neighbours, 0..5 elements (0: none, the default;
+        :func:`~.band_bank.smooth_densities`). [``band_smoothing``]
     spectrum_floor : float
         Band elements whose heave density is below this fraction of the highest are left out,
         [0, 1). [``spectrum_floor``]
@@ -219,6 +223,7 @@ class HeaveObserverParams:
     damping: float = 0.1
     stages: int = 3
     band_variance: str = "integral"
+    band_smoothing: int = 0
     spectrum_floor: float = 1e-3
     acc_noise: float = 7e-4
     mode_noise: float = 1e-2
@@ -246,6 +251,7 @@ class HeaveObserverParams:
         check_range("damping", self.damping, lo=0.0, hi=1.0, lo_open=True)
         check_int("stages", self.stages, lo=1, hi=4)
         check_choice("band_variance", self.band_variance, BAND_VARIANCES)
+        check_int("band_smoothing", self.band_smoothing, lo=0, hi=5)
         check_range("spectrum_floor", self.spectrum_floor, lo=0.0, hi=1.0, hi_open=True)
         check_range("min_separation", self.min_separation, lo=0.0, hi=2.0, lo_open=True, unit="rad/s")
         check_range("min_relative", self.min_relative, lo=0.0, hi=1.0, hi_open=True)
@@ -591,7 +597,7 @@ class HeaveObserver:
         if p.model == "band":
             omega, variance = band_elements(spectrum, band_grid(max(p.omega_min, p.band_min), p.omega_max,
                                                                 p.elements), p.spectrum_floor,
-                                              p.band_variance)
+                                              p.band_variance, p.band_smoothing)
         else:
             omega, variance = modes.omega, None
         if len(modes) == 0 or len(omega) == 0:

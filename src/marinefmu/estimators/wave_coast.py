@@ -93,6 +93,22 @@ BAND_MIN = 0.25
 #: the 40 dropouts of 2026-11-23 by noise only (``marinefmu bench --parts dropout``: mean
 #: N / E / D 2.0 / 6.8 / 4.2 cm as before, 2 of 40 at 10 cm or more instead of 1).
 
+#: Half-width of the smoothing of the band observers' element densities over their neighbours
+#: (with tilt states; :func:`~.band_bank.smooth_densities`; the heave observer's default is 0).
+#: The dropouts come minutes into a run, when the spectrum window holds one realisation of a few
+#: minutes, whose element weights scatter ±50 % about the sea's (with the 1 h spectrum of
+#: another seed, an oracle, the ten hardest dropouts erred 9.2 / 7.87 cm worst / mean east
+#: instead of 10.7 / 8.66 cm). Scans of 2026-11-24 (max east error through the gap, fused real
+#: time; the smoothed densities scaled to keep their sum, where the code keeps the variance):
+#: on the ten hardest, log-domain 1-2-1 9.7 / 8.11 cm, 1-2-3-2-1 10.0 / 8.05 cm; in the
+#: linear domain 1-2-1 10.2 / 8.65 cm, and a multitaper spectrum (DPSS, NW 2-6) 16.1-17.1 cm
+#: worst (its tapers spread the low-frequency tilt into the lowest elements, which the
+#: periodogram leaves below the floor). Over the 60 early dropouts with log 1-2-1: none at 10 cm
+#: or more (9.65 cm on seed 27 at 350 s, 10.7 before), mean N / E / D 2.04 / 6.06 / 2.91 cm
+#: (2.04 / 6.27 / 2.99), better on 41 and worse on 9. ``make bench`` (part ``dropout``) in the
+#: README.
+BAND_SMOOTHING = 1
+
 
 class WaveCoast:
     """Wave-frequency motion plus drift per NED axis, aided by GNSS (module docstring).
@@ -126,7 +142,8 @@ class WaveCoast:
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
         # spectrum: with tilt states the heave observer's own settings, without them its old ones
-        old = {} if self.tilt is not None else {"window_max": self.spectrum_window, "band_variance": "point"}
+        old = ({"band_smoothing": BAND_SMOOTHING} if self.tilt is not None
+               else {"window_max": self.spectrum_window, "band_variance": "point"})
         vertical = HeaveObserverParams(model="band", smoother_lag=0.0, peak_interval=PEAK_INTERVAL,
                                        window=self.spectrum_window, band_min=BAND_MIN, **old)
         # with tilt states the offset takes only the accelerometer bias, as on the vertical
