@@ -108,7 +108,8 @@ BAND_MIN = 0.25
 #: 10.7 before), mean N / E / D 2.04 / 6.06 / 2.91 cm (2.04 / 6.27 / 2.99), better on 41 and
 #: worse on 9; over the 60 later ones mean east 5.94 cm (6.02), better on 32 and worse on 12,
 #: but one at 10.4 cm (seed 2 at 1200 s; 9.7 before). On 20 fresh dropouts (seeds 41-60 at
-#: 330 s, a scan) no change: mean east 6.27 cm (6.29), worst 10.1 cm either way. A small gain
+#: 330 s, a scan) no change: mean east 6.27 cm (6.29), worst 10.1 cm either way; at 1230 s
+#: 5.61 cm (5.70), worst 7.3 cm (7.2). A small gain
 #: on the mean, none on the tail. The heave observer keeps 0: on its 30-min checks the band
 #: model's RMS error moved by at most 0.5 % (Hs 4 / Tp 14 2.941 → 2.956 cm, Hs 4 / Tp 12
 #: 2.297 → 2.313, Hs 2.5 / Tp 9 1.033 → 1.030, Hs 1 / Tp 6 0.265 → 0.266; a scan), as its
