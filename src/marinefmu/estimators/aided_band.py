@@ -92,7 +92,10 @@ Scans: with an offset noise of 3e-4 also 2 (12.2 cm worst, mean east 6.6 cm);
 ``gyro_bias_sigma`` 1e-4, 3; ``coast_attitude_tau`` 50 s, 3 (13.1 cm). With the tilt states the
 band observers' spectrum counts too: with the heave observer's own settings (a growing window,
 integrated variances; :mod:`.wave_coast`) 1 of the 60 (10.7 cm, seed 27), mean N / E / D
-2.0 / 6.3 / 3.0 cm (``make bench``, part ``dropout``, 2026-11-24).
+2.0 / 6.3 / 3.0 cm; with the element weights smoothed over neighbours
+(:data:`~.wave_coast.BAND_SMOOTHING`) none (worst 9.7 cm), mean 2.0 / 6.1 / 2.9 cm, but 1 of the
+same 60 later in a run (10.4 cm, seed 2 at 1200 s) (``make bench``, part ``dropout``,
+2026-11-24).
 
 What is left on east is at the wave frequency: through seed 27's gap the error swung ±9 cm
 at the 8 s peak period on a ±1.5 m sway (±4 cm with the true attitude; before the spectrum

@@ -39,7 +39,8 @@ def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyr
     smooth : bool
         Also return the RTS fixed-interval smoothed ``pos_smooth`` and ``vel_smooth``. Through
         a GNSS gap of up to ``max_coast`` s it does better than the real-time output (30 s
-        dropouts of the paper-001 set-up: worst east 9.1 cm against 10.7 cm); over a longer
+        dropouts of the paper-001 set-up: worst east 9.0 cm against 9.7 cm, and 9.4 against
+        10.4 cm later in a run; ``make bench``, part ``dropout``); over a longer
         one, which ends in a re-initialisation that the smoother does not cross, and over a
         gap that ends the record, it is the real-time output (:func:`orphan_steps`).
 

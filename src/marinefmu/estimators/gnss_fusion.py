@@ -207,8 +207,9 @@ class FusionParams:
         Needs ``coast="band"``, the attitude correction and a gyro. Over the
         60 dropouts of the README (paper 001): east at 10 cm or more in 2 instead of 4, worst
         11.8 cm instead of 15.4 cm, mean unchanged (6.6 cm); with the heave observer's spectrum
-        settings that the tilt states bring (:mod:`.wave_coast`) 1, 10.7 cm, mean 6.3 cm
-        (``make bench``, part ``dropout``, 2026-11-24). [``coast_tilt``]
+        settings that the tilt states bring (:mod:`.wave_coast`) 1, 10.7 cm, mean 6.3 cm;
+        with the spectrum smoothed (:data:`~.wave_coast.BAND_SMOOTHING`) none, worst 9.7 cm,
+        mean 6.1 cm (``make bench``, part ``dropout``, 2026-11-24). [``coast_tilt``]
     gyro_bias_sigma : float
         Gyro bias instability, the Gauss-Markov standard deviation of the tilt states' bias
         error [rad/s], (0, 1] (VesselMotion's default 5e-5; 1e-4 coasted worse: 3 of 60 over
