@@ -32,6 +32,7 @@ import math
 
 import numpy as np
 from scipy.linalg import block_diag, expm, solve_continuous_lyapunov
+from scipy.ndimage import convolve1d
 
 from .oscillator_bank import BankModel, steady_state_filter
 from .wave_peaks import Spectrum, band_integral
@@ -150,9 +151,9 @@ def smooth_densities(density: np.ndarray, width: np.ndarray, half_width: int) ->
     average is of log densities (a geometric mean: a steep band edge, where the density falls
     by decades from one element to the next, does not spill into the elements beyond it, as an
     arithmetic mean or a wider periodogram taper does), with binomial weights (1-2-1 for
-    ``half_width`` 1), the end values repeated at the ends; the result is scaled so that
-    Σ density·width is unchanged (a geometric mean of scattered values is biased low).
-    Hand-written: scipy has no log-domain smoother; :func:`numpy.convolve` does the sum.
+    ``half_width`` 1), the end values repeated at the ends (:func:`scipy.ndimage.convolve1d`,
+    ``mode="nearest"``); the result is scaled so that Σ density·width is unchanged (a
+    geometric mean of scattered values is biased low).
 
     Parameters
     ----------
@@ -175,8 +176,7 @@ def smooth_densities(density: np.ndarray, width: np.ndarray, half_width: int) ->
     weights = np.array([math.comb(2 * half_width, k) for k in range(2 * half_width + 1)], dtype=float)
     weights /= weights.sum()
     log_d = np.log(np.maximum(density, density.max() * 1e-12))
-    padded = np.concatenate([np.full(half_width, log_d[0]), log_d, np.full(half_width, log_d[-1])])
-    smooth = np.exp(np.convolve(padded, weights, mode="valid"))
+    smooth = np.exp(convolve1d(log_d, weights, mode="nearest"))
     return smooth * float(np.sum(density * width) / np.sum(smooth * width))
 
 
