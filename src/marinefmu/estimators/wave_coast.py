@@ -148,11 +148,12 @@ class WaveCoast:
 
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
-        # spectrum: with tilt states the heave observer's own settings, without them its old ones
-        old = ({"band_smoothing": BAND_SMOOTHING} if self.tilt is not None
-               else {"window_max": self.spectrum_window, "band_variance": "point"})
+        # spectrum: with tilt states the heave observer's own settings and smoothed element
+        # weights (BAND_SMOOTHING), without them its old settings
+        spectrum = ({"band_smoothing": BAND_SMOOTHING} if self.tilt is not None
+                    else {"window_max": self.spectrum_window, "band_variance": "point"})
         vertical = HeaveObserverParams(model="band", smoother_lag=0.0, peak_interval=PEAK_INTERVAL,
-                                       window=self.spectrum_window, band_min=BAND_MIN, **old)
+                                       window=self.spectrum_window, band_min=BAND_MIN, **spectrum)
         # with tilt states the offset takes only the accelerometer bias, as on the vertical
         horizontal = vertical if self.tilt is not None else replace(vertical, offset_noise=HORIZONTAL_OFFSET_NOISE)
         self.observers = [HeaveObserver(horizontal, quiet=True), HeaveObserver(horizontal, quiet=True),
