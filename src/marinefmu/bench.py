@@ -14,7 +14,8 @@ Then (``parts``): the paper 003 heave accuracy over seven seas (:func:`heave_acc
 marinefmu beside smsfusion on VesselMotion records (``peer``) and on smsfusion's OrcaFlex record
 (``orcaflex``), the GNSS dropout coast of paper 001 over 60 dropouts early in a run and the same 60 later, real time and RTS-smoothed, and the linear bound
 through them (``dropout``, :func:`marinefmu.examples.paper001.dropouts`,
-:func:`marinefmu.examples.gap_bound.gap_bound`), the fusion's ``pos_std`` against its error away
+:func:`marinefmu.examples.gap_bound.gap_bound`), the first 60 again with a tactical-grade gyro
+(``dropout_gyro``, :data:`marinefmu.examples.paper001.TACTICAL_GYRO`), the fusion's ``pos_std`` against its error away
 from GNSS gaps (``pos_std``, :func:`marinefmu.examples.paper001.pos_std_between_fixes`), the whole system (``system``, :mod:`marinefmu.bench_system`: accuracy in three
 seas, speed under FMPy, in-process and libcosim and on do-nothing FMUs (the master's floor), memory of a 3-hour run), the heave
 compensation's design loop and four-way comparison (``ahc``, :mod:`marinefmu.bench_ahc`), and
@@ -146,7 +147,7 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
 
 
 #: Parts of ``marinefmu bench``, in the order they run.
-PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "pos_std", "system", "ahc", "campaign", "memory")
+PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "dropout_gyro", "pos_std", "system", "ahc", "campaign", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks, Hs [m], Tp [s]; Hs 4 / Tp 12 and
@@ -291,7 +292,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
     what they measure; return the whole file's data.
 
     ``speed`` takes a few minutes, ``heave`` about twenty (seven seas with their causal bounds, the ``band_min`` and ``window_max`` studies), ``peer`` about one, ``orcaflex`` a
-    few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 60 GNSS dropouts of 30 s 4.5-6.7 min into a run, the same 60 another 15 min later, and 4 of 5 min, real time and RTS-smoothed, and the best linear estimator's errors through the first 60, :func:`~.examples.gap_bound.gap_bound`) about thirty, ``pos_std`` (:func:`~.examples.paper001.pos_std_between_fixes`, the fusion's ``pos_std`` against its error away from gaps, 22 runs of 300 s) a few minutes, ``system`` (three seas, three engines, do-nothing FMUs and a 3-hour run) about half an hour,
+    few seconds, ``dropout`` (:func:`~.examples.paper001.dropouts`, 60 GNSS dropouts of 30 s 4.5-6.7 min into a run, the same 60 another 15 min later, and 4 of 5 min, real time and RTS-smoothed, and the best linear estimator's errors through the first 60, :func:`~.examples.gap_bound.gap_bound`) about thirty, ``dropout_gyro`` (the first 60 with a tactical-grade gyro, :data:`~.examples.paper001.TACTICAL_GYRO`) about six, ``pos_std`` (:func:`~.examples.paper001.pos_std_between_fixes`, the fusion's ``pos_std`` against its error away from gaps, 22 runs of 300 s) a few minutes, ``system`` (three seas, three engines, do-nothing FMUs and a 3-hour run) about half an hour,
     ``memory`` (``memory_steps`` steps and ``memory_cycles`` cycles per FMU) about an hour on a
     2-core machine."""
     from .cosim.build import build_all, repo_root
@@ -340,6 +341,16 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             print(f"best linear estimator knowing the statistics (gap_bound), east, same dropouts: {bound['over_goal']} at "
                   f">= 10 cm; worst {100 * bound['worst_m']:.1f} cm, mean {100 * bound['mean_m']:.1f} cm")
             data["dropout"] = {**stamp, **d, "late": late, "five_minutes": long, "linear_bound_east": bound}
+        elif part == "dropout_gyro":
+            from .examples import paper001
+
+            r = paper001.dropouts(gyro=paper001.TACTICAL_GYRO)
+            print(f"GNSS dropout coast with a tactical-grade gyro (bias instability {r['gyro'][0]:g} rad/s, white noise "
+                  f"{r['gyro'][1]:g} rad/s/sqrt(Hz)), {len(r['cases'])} dropouts of {r['duration_s']:g} s: {r['over_goal']} "
+                  f"with an axis >= {100 * r['goal_m']:g} cm; worst N / E / D "
+                  f"{' / '.join(f'{100 * v:.1f}' for v in r['worst_m'])} cm, mean "
+                  f"{' / '.join(f'{100 * v:.1f}' for v in r['mean_m'])} cm")
+            data["dropout_gyro"] = {**stamp, **r}
         elif part == "pos_std":
             from .examples import paper001
 

@@ -252,11 +252,24 @@ LATE_DROPOUTS = tuple((start + 900.0, seed) for start, seed in DROPOUTS)
 LONG_DROPOUTS = tuple((270.0, seed) for seed in range(1, 5))
 
 
-def dropout_record(start: float, seed: int, duration: float = 30.0) -> dict[str, np.ndarray]:
+#: A tactical-grade gyro (bias instability [rad/s], white-noise density [rad/s/√Hz]): 1e-5 rad/s
+#: is 2 °/h, 1.5e-5 rad/s/√Hz an angle random walk of 0.05 °/√h (fibre-optic gyros of the class
+#: used on survey vessels), against VesselMotion's default MEMS gyro of 5e-5 and 5e-5 (10 °/h,
+#: 0.17 °/√h). For :func:`dropouts` with ``gyro``: the tail of the 30 s dropout is the coast's
+#: tilt estimate, which the gyro's bias wander and angle random walk turn through the gap.
+TACTICAL_GYRO = (1e-5, 1.5e-5)
+
+
+def dropout_record(start: float, seed: int, duration: float = 30.0,
+                   gyro: tuple[float, float] | None = None) -> dict[str, np.ndarray]:
     """:func:`simulate` record of a ``duration`` s GNSS dropout at ``start`` s (1 Hz RTK, sea and
-    sensor ``seed``), running on 10 s after it."""
-    return simulate(start + duration + 10.0, {"gnss.rate": 1.0, "gnss.dropout.start": start,
-                                              "gnss.dropout.duration": duration, "sea.seed": seed, "sensors.seed": seed})
+    sensor ``seed``), running on 10 s after it; ``gyro`` = (bias instability [rad/s], white-noise
+    density [rad/s/√Hz]) replaces the default MEMS gyro's (e.g. :data:`TACTICAL_GYRO`)."""
+    extra = {"gnss.rate": 1.0, "gnss.dropout.start": start, "gnss.dropout.duration": duration,
+             "sea.seed": seed, "sensors.seed": seed}
+    if gyro is not None:
+        extra.update({"imu.gyro_bias_instability": gyro[0], "imu.gyro_noise": gyro[1]})
+    return simulate(start + duration + 10.0, extra)
 
 
 def gap_slices(start: float, duration: float) -> tuple[slice, slice]:
@@ -266,7 +279,8 @@ def gap_slices(start: float, duration: float) -> tuple[slice, slice]:
     return gap, slice(int(round((start + COAST_AFTER) / DT)), gap.stop)
 
 
-def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict:
+def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10,
+             gyro: tuple[float, float] | None = None) -> dict:
     """The fused real-time COG through a ``duration`` s GNSS dropout (1 Hz RTK, wave-model
     coast) for each (start, seed) of ``cases``: the largest error per axis [m] in the gap.
 
@@ -281,12 +295,15 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
     the record runs on 10 s after the gap, so the smoother has 10 s of fixes after it): per case
     ``max_error_smoothed_m``, and ``smoothed`` with its ``over_goal``, ``worst_m`` and
     ``mean_m``. Prints one line per case as it goes (about 5 s each, 20 s at
-    :data:`LATE_DROPOUTS`).
+    :data:`LATE_DROPOUTS`). ``gyro`` (bias instability [rad/s], white-noise density
+    [rad/s/√Hz]), e.g. :data:`TACTICAL_GYRO`, replaces the default MEMS gyro in the simulation,
+    and the fusion is told it (``gyro_bias_sigma``, ``gyro_noise``).
     """
     rows, err_all, std_all = [], [], []
+    fusion = params() if gyro is None else params(gyro_bias_sigma=gyro[0], gyro_noise=gyro[1])
     for i, (start, seed) in enumerate(cases):
-        rec = dropout_record(start, seed, duration)
-        r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], params(), gnss_valid=rec["gnss_valid"],
+        rec = dropout_record(start, seed, duration, gyro)
+        r = fuse(rec["acc"], DT, rec["gnss"], rec["gnss_new"], rec["gyro"], fusion, gnss_valid=rec["gnss_valid"],
                  smooth=True)
         gap, coasted = gap_slices(start, duration)
         err = np.max(np.abs(r["pos"][gap] - rec["cog"][gap]), axis=0)
@@ -297,7 +314,7 @@ def dropouts(cases=DROPOUTS, duration: float = 30.0, goal: float = 0.10) -> dict
         print(f"dropout {i + 1}/{len(cases)} at {start:g} s, seed {seed}: max N / E / D "
               f"{' / '.join(f'{100 * e:.1f}' for e in err)} cm (RTS-smoothed "
               f"{' / '.join(f'{100 * e:.1f}' for e in err_s)} cm)", flush=True)
-    return {"cases": rows, "duration_s": duration, "goal_m": goal,
+    return {"cases": rows, "duration_s": duration, "goal_m": goal, "gyro": gyro,
             **max_error_summary([row["max_error_m"] for row in rows], goal),
             "smoothed": max_error_summary([row["max_error_smoothed_m"] for row in rows], goal),
             "pos_std": calibration(np.concatenate(err_all), np.concatenate(std_all))}
