@@ -146,6 +146,11 @@ def memory(fmu_dir: Path, steps: int, cycles: int) -> dict[str, dict]:
     return result
 
 
+def _times_100(values) -> str:
+    """N / E / D values × 100 to one decimal, joined by " / " (metres as centimetres, fractions as percent)."""
+    return " / ".join(f"{100 * v:.1f}" for v in values)
+
+
 #: Parts of ``marinefmu bench``, in the order they run.
 PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "dropout_gyro", "pos_std", "system", "ahc", "campaign", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
@@ -329,14 +334,14 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             for r in (d, late, long):
                 c = r["pos_std"]
                 print(f"GNSS dropout coast, {len(r['cases'])} dropouts of {r['duration_s']:g} s: {r['over_goal']} with an "
-                      f"axis >= {100 * r['goal_m']:g} cm; worst N / E / D {' / '.join(f'{100 * v:.1f}' for v in r['worst_m'])} "
-                      f"cm, mean {' / '.join(f'{100 * v:.1f}' for v in r['mean_m'])} cm; error / pos_std RMS "
+                      f"axis >= {100 * r['goal_m']:g} cm; worst N / E / D {_times_100(r['worst_m'])} "
+                      f"cm, mean {_times_100(r['mean_m'])} cm; error / pos_std RMS "
                       f"{' / '.join(f'{v:.2f}' for v in c['rms_z'])}, beyond 2 in "
-                      f"{' / '.join(f'{100 * v:.1f}' for v in c['beyond_2'])} % of the time")
+                      f"{_times_100(c['beyond_2'])} % of the time")
                 m = r["smoothed"]
                 print(f"  RTS-smoothed (post-processing, 10 s of fixes after the gap): {m['over_goal']} with an axis >= "
-                      f"{100 * r['goal_m']:g} cm; worst N / E / D {' / '.join(f'{100 * v:.1f}' for v in m['worst_m'])} "
-                      f"cm, mean {' / '.join(f'{100 * v:.1f}' for v in m['mean_m'])} cm")
+                      f"{100 * r['goal_m']:g} cm; worst N / E / D {_times_100(m['worst_m'])} "
+                      f"cm, mean {_times_100(m['mean_m'])} cm")
             bound = gap_bound.gap_bound()
             print(f"best linear estimator knowing the statistics (gap_bound), east, same dropouts: {bound['over_goal']} at "
                   f">= 10 cm; worst {100 * bound['worst_m']:.1f} cm, mean {100 * bound['mean_m']:.1f} cm")
@@ -348,8 +353,8 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             print(f"GNSS dropout coast with a tactical-grade gyro (bias instability {r['gyro'][0]:g} rad/s, white noise "
                   f"{r['gyro'][1]:g} rad/s/sqrt(Hz)), {len(r['cases'])} dropouts of {r['duration_s']:g} s: {r['over_goal']} "
                   f"with an axis >= {100 * r['goal_m']:g} cm; worst N / E / D "
-                  f"{' / '.join(f'{100 * v:.1f}' for v in r['worst_m'])} cm, mean "
-                  f"{' / '.join(f'{100 * v:.1f}' for v in r['mean_m'])} cm")
+                  f"{_times_100(r['worst_m'])} cm, mean "
+                  f"{_times_100(r['mean_m'])} cm")
             data["dropout_gyro"] = {**stamp, **r}
         elif part == "pos_std":
             from .examples import paper001
@@ -358,7 +363,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             for name, c in checks.items():
                 print(f"pos_std between fixes, {name}, seeds {c['seeds'][0]}-{c['seeds'][-1]}: error / pos_std RMS "
                       f"{' / '.join(f'{lo:.2f}-{hi:.2f}' for lo, hi in zip(c['least_rms_z'], c['worst_rms_z']))} "
-                      f"N / E / D, beyond 2 in {' / '.join(f'{100 * v:.1f}' for v in c['beyond_2'])} % of the time")
+                      f"N / E / D, beyond 2 in {_times_100(c['beyond_2'])} % of the time")
             data["pos_std"] = {**stamp, "cases": checks}
         elif part == "system":
             from .bench_system import whole_system
