@@ -126,7 +126,7 @@ FUSION_PARAMETERS: list[Variable] = [
     real("antenna_sigma_h", _FU.antenna_sigma_h, "m", "Horizontal noise of one antenna position (the fix attitude's weight in the tilt states), (0, 100]"),
     real("antenna_sigma_v", _FU.antenna_sigma_v, "m", "Vertical noise of one antenna position, (0, 100]"),
     real("acc_noise", _FU.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, for pos_std only (the filter blends with q), (0, 10]"),
-    real("gyro_noise", _FU.gyro_noise, "rad/s/sqrt(Hz)", "Gyro white-noise density (angle random walk), for pos_std only, (0, 1]"),
+    real("gyro_noise", _FU.gyro_noise, "rad/s/sqrt(Hz)", "Gyro white-noise density (angle random walk), for the tilt states and pos_std, (0, 1]"),
 ]
 FUSION_INPUTS: list[Variable] = [
     *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),

@@ -74,7 +74,8 @@ accelerometer bias under 1 mm/s²). Until then a loose random-walk offset
 g·ε, and took a few percent of the sway at the wave peak with it (|1 − H| 3 % at 0.77 rad/s).
 Now the north and east filters carry ε and the gyro-bias error δ that turns it,
 
-    ε̇ = δ,  δ Gauss-Markov (the gyro's bias instability and correlation time),
+    ε̇ = δ + w,  δ Gauss-Markov (the gyro's bias instability and correlation time),
+    w white (the gyro's white noise, its angle random walk; ARW below),
 
 with ``gain``·ε in the acceleration row (and −J·gain in Ā, the increment form's feed-through),
 measured at every fix by the antenna attitude's error against the coast's attitude (σ from the
@@ -129,14 +130,16 @@ class Tilt:
     ε [rad] is the component of that attitude's error (n frame, true = exp(ε)·used) whose
     g-multiple lands on this axis: the axis's acceleration is off by ``gain``·ε (east −g·ε_N,
     north +g·ε_E; :class:`~.wave_coast.WaveCoast`). It grows with the gyro-bias error
-    δ [rad/s], ε̇ = δ, a Gauss-Markov process of standard deviation ``bias_sigma`` and
-    correlation time ``bias_tau`` (the gyro's datasheet). Each GNSS fix's antenna attitude
-    measures ε (:meth:`AidedBand.attitude_fix`).
+    δ [rad/s] and the gyro's white noise, ε̇ = δ + w, δ a Gauss-Markov process of standard
+    deviation ``bias_sigma`` and correlation time ``bias_tau``, w white of density ``noise``
+    (the angle random walk; the gyro's datasheet). Each GNSS fix's antenna attitude measures ε
+    (:meth:`AidedBand.attitude_fix`).
     """
 
     gain: float                       # [m/s²/rad]
     bias_sigma: float                 # [rad/s]
     bias_tau: float                   # [s]
+    noise: float = 0.0                # white-noise density of the gyro [rad/s/√Hz]
     prior: float = 5e-3               # standard deviation of ε at a start [rad]
     offset_prior: float = 2e-3        # standard deviation of the offset at the first model [m/s²]
 
@@ -234,6 +237,7 @@ class AidedBand:
             self.F[d + 2, d + 3] = t.bias_tau * (1.0 - phi)
             self.F[d + 3, d + 3] = phi
             self.Q[d + 3, d + 3] = t.bias_sigma ** 2 * (1.0 - phi * phi)
+            self.Q[d + 2, d + 2] = t.noise ** 2 * self.dt      # the angle random walk
             self.C[d + 2] = t.gain
             # decorrelated increment form: Ā = A − J C over the tilt's column too
             self.F[:n, d + 2] = -self.J[:n] * t.gain

@@ -227,7 +227,9 @@ class FusionParams:
         with ``q``. [``acc_noise``]
     gyro_noise : float
         Gyro white-noise density (angle random walk) [rad/s/√Hz], (0, 1] (VesselMotion's
-        default 5e-5), for ``pos_std`` only, with ``gyro_bias_sigma`` and ``gyro_bias_tau``.
+        default 5e-5): the random walk of the tilt states' attitude error (``coast_tilt``,
+        :class:`~.aided_band.Tilt`; until 2026-11-24 they had the bias wander alone), and with
+        ``gyro_bias_sigma`` and ``gyro_bias_tau`` the attitude error of ``pos_std``.
         [``gyro_noise``]
     """
 
@@ -446,7 +448,8 @@ class GnssAccFusion:
         self.residual = 0.0
         self.acc_n = np.zeros(3)
         # tilt states need the coast's own gyro attitude, whose errors they track
-        tilt = (p.gyro_bias_sigma, p.gyro_bias_tau) if (p.coast_tilt and p.attitude_correction) else None
+        tilt = ((p.gyro_bias_sigma, p.gyro_bias_tau, p.gyro_noise) if (p.coast_tilt and p.attitude_correction)
+                else None)
         self.coaster = WaveCoast(p.coast_window, tilt=tilt) if p.coast == "band" else None
         # the coast corrects its acceleration with its own gyro attitude (coast_attitude_tau)
         # when there is a correction and a gyro; otherwise it takes acc_n

@@ -128,8 +128,10 @@ class WaveCoast:
         First spectrum window of the band observers [s] (:data:`SPECTRUM_WINDOW`); no position
         before it has passed, ≥ 4π/``omega_min`` of the heave observer (50.3 s).
     tilt : tuple of float, optional
-        (σ [rad/s], τ [s]) of the gyro-bias error for tilt states in the north and east
-        filters (module docstring); None: none, and a loose horizontal offset.
+        (σ [rad/s], τ [s]) of the gyro-bias error, and optionally the gyro's white-noise
+        density [rad/s/√Hz] (default 0), for tilt states in the north and east filters
+        (module docstring, :class:`~.aided_band.Tilt`); None: none, and a loose horizontal
+        offset.
 
     Examples
     --------
@@ -140,7 +142,7 @@ class WaveCoast:
     """
 
     def __init__(self, window: float, spectrum_window: float = SPECTRUM_WINDOW,
-                 tilt: tuple[float, float] | None = None) -> None:
+                 tilt: tuple[float, ...] | None = None) -> None:
         self.window = float(window)
         self.spectrum_window = float(spectrum_window)
         self.tilt = tilt
@@ -211,9 +213,8 @@ class WaveCoast:
         self.block = max(1, int(round(1.0 / (RATE * dt))))
         tilts: list[Tilt | None] = [None, None, None]
         if self.tilt is not None:
-            sigma, tau = self.tilt
             # north a_n is off by +g·ε_E, east by −g·ε_N (class docstring)
-            tilts = [Tilt(G, sigma, tau), Tilt(-G, sigma, tau), None]
+            tilts = [Tilt(G, *self.tilt), Tilt(-G, *self.tilt), None]
         self.bands = [AidedBand(drift_noise(self.window), self.block * self.dt, t) for t in tilts]
 
     @property
