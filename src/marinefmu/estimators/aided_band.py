@@ -98,6 +98,18 @@ integrated variances; :mod:`.wave_coast`) 1 of the 60 (10.7 cm, seed 27), mean N
 same 60 later in a run (10.4 cm, seed 2 at 1200 s) (``make bench``, part ``dropout``,
 2026-11-24).
 
+ARW (session 32, 2026-11-24): the coast's attitude integrates the gyro's white noise too, a
+random walk of ε of density ``noise`` (:class:`Tilt`, the fusion's ``gyro_noise``), which
+the tilt states used to leave out (Q on ε zero). With it, on a synthetic tilt that walks at
+5e-4 rad/s/√Hz, the tilt estimate errs what its covariance says (RMS / σ 0.74-1.01 over ten
+seeds, against 4.0-8.7 without) and the gap error falls from 14-54 to 9-14 cm (test). On the
+paper-001 set-up (scans): over 200 fresh 30 s dropouts east reaches 10 cm in 1 instead of 3,
+mean 5.78 cm instead of 5.87, 95th percentile 8.1 cm instead of 8.3; with a gyro of 1e-5
+rad/s bias instability and the MEMS white noise seed 27 at 350 s errs 10.1 cm instead of
+12.2, with a tactical-grade gyro 8.3 instead of 8.5 cm. On the 60 early bench dropouts the
+mean east falls 6.06 → 5.90 cm, but seed 27 at 350 s rises 9.7 → 10.7 cm: the tail moves,
+as with every change here.
+
 What is left on east is at the wave frequency: through seed 27's gap the error swung ±9 cm
 at the 8 s peak period on a ±1.5 m sway (±4 cm with the true attitude; before the spectrum
 settings). What tells the sway
