@@ -151,6 +151,13 @@ def _times_100(values) -> str:
     return " / ".join(f"{100 * v:.1f}" for v in values)
 
 
+def _over_goal(summary: dict, goal: float) -> str:
+    """The count over ``goal`` [m] and the worst and mean errors per axis of a
+    :func:`~.examples.paper001.max_error_summary`, in centimetres."""
+    return (f"{summary['over_goal']} with an axis >= {100 * goal:g} cm; worst N / E / D "
+            f"{_times_100(summary['worst_m'])} cm, mean {_times_100(summary['mean_m'])} cm")
+
+
 #: Parts of ``marinefmu bench``, in the order they run.
 PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "dropout_gyro", "pos_std", "system", "ahc", "campaign", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
@@ -333,15 +340,12 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             long = paper001.dropouts(paper001.LONG_DROPOUTS, duration=300.0, goal=0.5)
             for r in (d, late, long):
                 c = r["pos_std"]
-                print(f"GNSS dropout coast, {len(r['cases'])} dropouts of {r['duration_s']:g} s: {r['over_goal']} with an "
-                      f"axis >= {100 * r['goal_m']:g} cm; worst N / E / D {_times_100(r['worst_m'])} "
-                      f"cm, mean {_times_100(r['mean_m'])} cm; error / pos_std RMS "
+                print(f"GNSS dropout coast, {len(r['cases'])} dropouts of {r['duration_s']:g} s: "
+                      f"{_over_goal(r, r['goal_m'])}; error / pos_std RMS "
                       f"{' / '.join(f'{v:.2f}' for v in c['rms_z'])}, beyond 2 in "
                       f"{_times_100(c['beyond_2'])} % of the time")
-                m = r["smoothed"]
-                print(f"  RTS-smoothed (post-processing, 10 s of fixes after the gap): {m['over_goal']} with an axis >= "
-                      f"{100 * r['goal_m']:g} cm; worst N / E / D {_times_100(m['worst_m'])} "
-                      f"cm, mean {_times_100(m['mean_m'])} cm")
+                print(f"  RTS-smoothed (post-processing, 10 s of fixes after the gap): "
+                      f"{_over_goal(r['smoothed'], r['goal_m'])}")
             bound = gap_bound.gap_bound()
             print(f"best linear estimator knowing the statistics (gap_bound), east, same dropouts: {bound['over_goal']} at "
                   f">= 10 cm; worst {100 * bound['worst_m']:.1f} cm, mean {100 * bound['mean_m']:.1f} cm")
@@ -351,10 +355,8 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
 
             r = paper001.dropouts(gyro=paper001.TACTICAL_GYRO)
             print(f"GNSS dropout coast with a tactical-grade gyro (bias instability {r['gyro'][0]:g} rad/s, white noise "
-                  f"{r['gyro'][1]:g} rad/s/sqrt(Hz)), {len(r['cases'])} dropouts of {r['duration_s']:g} s: {r['over_goal']} "
-                  f"with an axis >= {100 * r['goal_m']:g} cm; worst N / E / D "
-                  f"{_times_100(r['worst_m'])} cm, mean "
-                  f"{_times_100(r['mean_m'])} cm")
+                  f"{r['gyro'][1]:g} rad/s/sqrt(Hz)), {len(r['cases'])} dropouts of {r['duration_s']:g} s: "
+                  f"{_over_goal(r, r['goal_m'])}")
             data["dropout_gyro"] = {**stamp, **r}
         elif part == "pos_std":
             from .examples import paper001
