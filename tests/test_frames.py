@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from marinefmu.frames import GRAVITY_N, attitude_kinematics, cross3, euler_rates_to_body, rigid_point_operator, rot_nb, specific_force
+from marinefmu.frames import (GRAVITY_N, attitude_kinematics, cross3, euler_rates_to_body, nav_tilt, rigid_point_operator,
+                              rot_nb, specific_force)
 
 rng = np.random.default_rng(3)
 ANGLES = rng.uniform([-0.5, -0.4, -3.1], [0.5, 0.4, 3.1], size=(20, 3))
@@ -51,3 +52,17 @@ def test_cross3_is_numpy_cross():
     rng = np.random.default_rng(4)
     for a, b in rng.normal(size=(50, 2, 3)):
         assert np.array_equal(cross3(a, b), np.cross(a, b))
+
+
+@pytest.mark.parametrize("roll,pitch,yaw", ANGLES)
+def test_nav_tilt_is_scipys_rotation_vector_without_the_yaw(roll, pitch, yaw):
+    """nav_tilt is the N / E part of scipy's rotation vector of R_nb·R_z(ψ)ᵀ, and a small
+    rotation exp([ε]×) of the attitude moves it by (ε_N, ε_E) to second order: off by at most
+    0.39 |ε|·|tilt| here (|tilt| = √(roll² + pitch²) up to 0.6 rad); bound 0.5 |ε|·|tilt|."""
+    r = rot_nb(roll, pitch, yaw)
+    expected = Rotation.from_matrix(r @ Rotation.from_euler("z", yaw).as_matrix().T).as_rotvec()[:2]
+    np.testing.assert_allclose(nav_tilt(r), expected, atol=1e-15)
+    eps = np.array([3e-3, -2e-3, 1e-3])
+    moved = Rotation.from_rotvec(eps).as_matrix() @ r
+    bound = 0.5 * np.linalg.norm(eps) * np.hypot(roll, pitch)
+    assert np.max(np.abs(nav_tilt(moved) - nav_tilt(r) - eps[:2])) < bound

@@ -247,3 +247,24 @@ def level_angles(f_b: np.ndarray) -> tuple[float, float]:
     (f_b = R_nbᵀ(−g_n) for a sensor at rest): φ = atan2(−f_y, −f_z), θ = atan2(f_x, √(f_y² + f_z²))."""
     fx, fy, fz = f_b
     return math.atan2(-fy, -fz), math.atan2(fx, math.hypot(fy, fz))
+
+
+def nav_tilt(rot: np.ndarray) -> np.ndarray:
+    """The tilt of the attitude R_nb about the north and east axes [rad]: the horizontal part
+    of the rotation vector of R_nb·R_z(ψ)ᵀ, the attitude with its yaw ψ taken off (to first
+    order roll and pitch turned into NED by the heading). A small rotation of the attitude,
+    R_nb → exp([ε]×)·R_nb, moves it by (ε_N, ε_E) to second order in the angles (the wave tilt
+    of :class:`~marinefmu.estimators.wave_coast.WaveCoast`).
+
+    Examples
+    --------
+    >>> [round(float(v), 12) for v in nav_tilt(rot_nb(0.01, 0.0, math.pi / 2))]
+    [0.0, 0.01]
+    """
+    yaw = math.atan2(rot[1, 0], rot[0, 0])
+    c, s = math.cos(yaw), math.sin(yaw)
+    rel = rot @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+    # the rotation vector of rel, by hand as the rest of this module (tests: scipy's Rotation)
+    angle = math.acos(max(-1.0, min(1.0, 0.5 * (np.trace(rel) - 1.0))))
+    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0]])
+    return axis * (0.5 if angle < 1e-8 else 0.5 * angle / math.sin(angle))

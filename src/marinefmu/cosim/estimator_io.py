@@ -121,6 +121,7 @@ FUSION_PARAMETERS: list[Variable] = [
     real("coast_attitude_tau", _FU.coast_attitude_tau, "s", "Time constant of the coast's own PI attitude (coast = band, propagation = gyro), 0.1..10000"),
     real("coast_window", _FU.coast_window, "s", "Memory of the drift model of coast = band, 10..3600"),
     Variable("coast_tilt", "boolean", _FU.coast_tilt, "", "Tilt-error states in the horizontal axes of coast = band (false: a loose offset takes the tilt, as before 2026-11-24)"),
+    Variable("coast_tilt_band", "boolean", _FU.coast_tilt_band, "", "With coast_tilt: the tilt states also measured by the coast attitude's own tilt, the wave roll and pitch as a band (false: by the acceleration alone, as before 2026-11-24)"),
     real("gyro_bias_sigma", _FU.gyro_bias_sigma, "rad/s", "Gyro bias instability (Gauss-Markov standard deviation) for the tilt states, (0, 1]"),
     real("gyro_bias_tau", _FU.gyro_bias_tau, "s", "Gyro bias correlation time for the tilt states, 0.1..1e6"),
     real("antenna_sigma_h", _FU.antenna_sigma_h, "m", "Horizontal noise of one antenna position (the fix attitude's weight in the tilt states), (0, 100]"),
@@ -162,7 +163,8 @@ def fusion_params(values: dict[str, Any]) -> FusionParams:
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
         coast=v["coast"], coast_sigma=v["coast_sigma"], coast_attitude_tau=v["coast_attitude_tau"],
-        coast_window=v["coast_window"], coast_tilt=bool(v["coast_tilt"]), gyro_bias_sigma=v["gyro_bias_sigma"],
+        coast_window=v["coast_window"], coast_tilt=bool(v["coast_tilt"]),
+        coast_tilt_band=bool(v["coast_tilt_band"]), gyro_bias_sigma=v["gyro_bias_sigma"],
         gyro_bias_tau=v["gyro_bias_tau"], antenna_sigma_h=v["antenna_sigma_h"], antenna_sigma_v=v["antenna_sigma_v"],
         acc_noise=v["acc_noise"], gyro_noise=v["gyro_noise"],
     )

@@ -210,6 +210,12 @@ class FusionParams:
         settings that the tilt states bring (:mod:`.wave_coast`) 1, 10.7 cm, mean 6.3 cm;
         with the spectrum smoothed (:data:`~.wave_coast.BAND_SMOOTHING`) none, worst 9.7 cm,
         mean 6.1 cm (``make bench``, part ``dropout``, 2026-11-24). [``coast_tilt``]
+    coast_tilt_band : bool
+        With ``coast_tilt``: the tilt states are also measured, at every band step, by the
+        coast attitude's own tilt about N / E, the vessel's wave roll and pitch modelled as a
+        band from their spectrum (:mod:`.wave_coast`, "The wave tilt"). In a gap this is the
+        second source of the tilt besides the acceleration. False: the acceleration alone
+        (until 2026-11-24). [``coast_tilt_band``]
     gyro_bias_sigma : float
         Gyro bias instability, the Gauss-Markov standard deviation of the tilt states' bias
         error [rad/s], (0, 1] (VesselMotion's default 5e-5; 1e-4 coasted worse: 3 of 60 over
@@ -253,6 +259,7 @@ class FusionParams:
     coast_attitude_tau: float = 150.0
     coast_window: float = 120.0
     coast_tilt: bool = True
+    coast_tilt_band: bool = True
     gyro_bias_sigma: float = 5e-5
     gyro_bias_tau: float = 50.0
     antenna_sigma_h: float = 0.01
@@ -450,7 +457,8 @@ class GnssAccFusion:
         # tilt states need the coast's own gyro attitude, whose errors they track
         tilt = ((p.gyro_bias_sigma, p.gyro_bias_tau, p.gyro_noise) if (p.coast_tilt and p.attitude_correction)
                 else None)
-        self.coaster = WaveCoast(p.coast_window, tilt=tilt) if p.coast == "band" else None
+        self.coaster = (WaveCoast(p.coast_window, tilt=tilt, tilt_band=p.coast_tilt_band and tilt is not None)
+                        if p.coast == "band" else None)
         # the coast corrects its acceleration with its own gyro attitude (coast_attitude_tau)
         # when there is a correction and a gyro; otherwise it takes acc_n
         self.coast_attitude = self.coaster is not None and p.attitude_correction
@@ -525,7 +533,11 @@ class GnssAccFusion:
             self.error.predict()
             self.prior = (self.kf.x.copy(), self.kf.P.copy())
         if self.coaster is not None and self.initialised:
-            self.coaster.add(quat_to_rot(self.q_coast) @ f_b + GRAVITY_N if self._coast_gyro() else self.acc_n, dt)
+            if self._coast_gyro():
+                rot_c = quat_to_rot(self.q_coast)
+                self.coaster.add(rot_c @ f_b + GRAVITY_N, dt, rot_c)
+            else:
+                self.coaster.add(self.acc_n, dt, rot)
         fix = ""
         if gnss is not None:
             fix, why = self._epoch(gnss, dt)

@@ -488,6 +488,12 @@ class HeaveObserver:
         self.smoother = FixedLagOutputs(int(round(p.smoother_lag / dt)), 2, 4)
 
     @property
+    def band_variance(self) -> float | None:
+        """Heave variance of the band model, the sum of its elements' [m²] (``model="band"``
+        with a model; else None)."""
+        return None if self._variance is None else float(np.sum(self._variance))
+
+    @property
     def delay(self) -> float:
         """Lag of the delayed outputs [s] (the increment model's states refer to the start of
         each step, one step more)."""
