@@ -41,6 +41,26 @@ the attitude error of the antenna fixes (about 5 mm/s² RMS at 0.1-0.25 rad/s wi
 on an 8 m baseline) and, in a gap, g × the gyro-propagated tilt drift, which a weaker offset
 leaves to the lowest band elements as displacement (with the aided filter, over the 30 dropouts of :mod:`.aided_band`, east over
 10 cm in 28 / 14 / 5 with 1e-4 / 3e-4 / 1e-3; 1e-3 raised to 3e-3 in gaps only: 12).
+
+The wave tilt (``tilt_band``, the default of :class:`~.gnss_fusion.GnssAccFusion` since
+2026-11-24, session 33). In a gap the tilt states had only the acceleration to tell the tilt
+error ε of the correcting attitude from sway, and what they missed was the whole tail of the
+30 s dropouts (told the true tilt, the five worst erred 2.3-3.8 cm instead of 10-11 cm;
+``docs/paper001_dropout.md``). The correcting attitude's own tilt about N and E
+(:func:`~marinefmu.frames.nav_tilt`) is the vessel's wave roll and pitch less ε, θ_used = θ − ε
+to second order, and a floating vessel's wave tilt has, like its sway, nothing below the
+wave band. So the north and east filters also carry a band model of the wave tilt about E / N
+and measure θ_used at every band step (:meth:`~.aided_band.AidedBand.wave_tilt`, σ
+:data:`~.aided_band.ANGLE_SIGMA`): in a gap the gyro's tilt, which turns with the bias, is
+then a second source of ε besides the acceleration. The band's spectrum comes from a fourth
+and fifth :class:`~.heave.HeaveObserver` fed the tilt's second difference at the band rate (its
+spectrum S_θ̈ = ω⁴S_θ, so its "heave" band is the tilt's), with the same window and floor and
+damping :data:`ANGLE_DAMPING`; the band drops the observer's offset. A tilt whose band variance is
+under ANGLE_SIGMA² gets no band: ε is measured alone, the tilt's variance added to the noise
+(:meth:`~.aided_band.AidedBand.weak_angle`; in the paper-001 beam sea the tilt about E is
+0.03 mrad, and 33 band elements of noise cost a third of the fusion's time). Measured (scans,
+2026-11-24, the 60 early dropouts of the README; ``make bench`` there): east worst 10.7 →
+9.8 cm, mean 5.9 → 5.2 cm, lower on 52 of the 60; north and down unchanged.
 """
 from __future__ import annotations
 
