@@ -58,9 +58,10 @@ spectrum S_θ̈ = ω⁴S_θ, so its "heave" band is the tilt's), with the same w
 damping :data:`ANGLE_DAMPING`; the band drops the observer's offset. A tilt whose band variance is
 under ANGLE_SIGMA² gets no band: ε is measured alone, the tilt's variance added to the noise
 (:meth:`~.aided_band.AidedBand.weak_angle`; in the paper-001 beam sea the tilt about E is
-0.03 mrad, and 33 band elements of noise cost a third of the fusion's time). Measured (scans,
-2026-11-24, the 60 early dropouts of the README; ``make bench`` there): east worst 10.7 →
-9.8 cm, mean 5.9 → 5.2 cm, lower on 52 of the 60; north and down unchanged.
+0.03 mrad, and a band of 33 elements of noise made the fusion take 9.3 s instead of 7.3 s
+for a 390 s record, a scan). ``make bench``, part ``dropout``, 2026-11-24, session 33, max
+east error through 30 s dropouts: the 60 early ones worst 10.7 → 9.9 cm, mean 5.9 → 5.3 cm;
+the 60 later ones 9.8 → 8.2 cm, 5.8 → 5.1 cm; north and down unchanged (README).
 """
 from __future__ import annotations
 
@@ -258,7 +259,7 @@ class WaveCoast:
             raise ValueError("WaveCoast.add needs the attitude with tilt_band")
         theta = nav_tilt(np.asarray(attitude, dtype=float))
         if not np.all(np.isfinite(theta)):
-            return                              # the fusion holds its attitude: not expected
+            return          # not expected: the fusion holds its last good attitude on a bad sample
         self.angles = (self.angles + [theta])[-3:]
         if len(self.angles) < 3:
             return
@@ -366,6 +367,9 @@ class WaveCoast:
             "bands": [b.get_state() for b in self.bands],
             "angle_observers": [o.get_state() for o in self.angle_observers],
             "angles": [a.tolist() for a in self.angles],
+            # whether each wave-tilt observer's model has been taken (about N, about E); a taken
+            # one is the observer's current model (_wave_tilt takes a new one as it comes)
+            "angle_taken": [m is not None for m in self.angle_models],
         }
 
     def set_state(self, s: dict) -> None:
@@ -384,8 +388,9 @@ class WaveCoast:
         angle_models = [o.model for o in self.angle_observers] + [None] * 3
         for b, o, a, st in zip(self.bands, self.observers, angle_models, s["bands"]):
             b.set_state(st, o.model, a)
-        # the observers' models as taken (a weak tilt's model was seen, though not adopted)
-        self.angle_models = [o.model for o in self.angle_observers[::-1]] or [None, None]
+        # the models taken (a weak tilt's too, though it has no band), restored as objects
+        observed = [o.model for o in self.angle_observers[::-1]] or [None, None]
+        self.angle_models = [m if taken else None for m, taken in zip(observed, s["angle_taken"])]
         self.angles = [np.array(a, dtype=float) for a in s["angles"]]
 
 
