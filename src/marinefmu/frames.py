@@ -15,6 +15,7 @@ import math
 from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 #: Standard gravity [m/s²] (ISO 80000-3), used for g_n = [0, 0, G].
 G = 9.80665
@@ -264,7 +265,5 @@ def nav_tilt(rot: np.ndarray) -> np.ndarray:
     yaw = math.atan2(rot[1, 0], rot[0, 0])
     c, s = math.cos(yaw), math.sin(yaw)
     rel = rot @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
-    # the rotation vector of rel, by hand as the rest of this module (tests: scipy's Rotation)
-    angle = math.acos(max(-1.0, min(1.0, 0.5 * (np.trace(rel) - 1.0))))
-    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0]])
-    return axis * (0.5 if angle < 1e-8 else 0.5 * angle / math.sin(angle))
+    # once per coast band step (20 Hz), not per sample: scipy's Rotation is cheap enough here
+    return Rotation.from_matrix(rel).as_rotvec()[:2]

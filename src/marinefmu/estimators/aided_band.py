@@ -305,11 +305,7 @@ class AidedBand:
         t[-e:, -e:] = np.eye(e)
         if old is not None:
             t[:n_new, :old.n] = carry_map(old.omega, model.omega, model.block)
-        x, p = t @ self.x, t @ self.P @ t.T
-        if old is None:
-            x[:n_new] = band_state
-        fresh = np.flatnonzero(~t[:n_new].any(axis=1))
-        restart(x, p, fresh, model.P[np.ix_(fresh, fresh)], x[fresh])
+        x, p = self._carry(t, 0, n_new, model, band_state if old is None else None)
         if old is None and self.tilt is not None:
             # the observer's offset holds the tilt's g·ε as well: start it at 0 with the
             # accelerometer-bias prior and let the tilt states take the rest (Tilt)
@@ -331,14 +327,22 @@ class AidedBand:
         t[:b, :b] = np.eye(b)
         if old is not None:
             t[b:, b:] = carry_map(old.omega, model.omega, model.block)[:-1, :-1]
-        x, p = t @ self.x, t @ self.P @ t.T
-        if old is None:
-            x[b:] = np.asarray(band_state, dtype=float)[:-1]
-        fresh = np.flatnonzero(~t[b:].any(axis=1))
-        restart(x, p, b + fresh, model.P[np.ix_(fresh, fresh)], x[b + fresh])
+        x, p = self._carry(t, b, model.n - 1, model, band_state if old is None else None)
         self.angle, self.weak_tilt = model, None
         self._configure()
         self.x, self.P = x, p
+
+    def _carry(self, t: np.ndarray, at: int, n: int, model: BankModel,
+               band_state: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """State and covariance mapped by ``t`` to a new element set of ``model`` whose first
+        ``n`` states sit at ``at``: set to ``band_state`` (its first ``n``) on a first model, and
+        elements with no predecessor restarted on the model's steady-state covariance."""
+        x, p = t @ self.x, t @ self.P @ t.T
+        if band_state is not None:
+            x[at:at + n] = np.asarray(band_state, dtype=float)[:n]
+        fresh = np.flatnonzero(~t[at:at + n].any(axis=1))
+        restart(x, p, at + fresh, model.P[np.ix_(fresh, fresh)], x[at + fresh])
+        return x, p
 
     def weak_angle(self, variance: float) -> None:
         """The wave tilt about this axis's tilt axis is too weak to model (its variance

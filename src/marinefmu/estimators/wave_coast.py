@@ -143,6 +143,16 @@ BAND_SMOOTHING = 1
 ANGLE_DAMPING = 0.05
 
 
+def observe(obs: HeaveObserver, value: float, dt: float) -> None:
+    """One sample ``value`` of an axis to its band observer, which sees the axis as a level
+    vertical (a_v = f_z + g with f_z = value − g): stepped until its first model, then only
+    its spectrum tracked (the coast's filters run the model)."""
+    if obs.model is None:
+        obs.step(value - G, 0.0, 0.0, dt)
+    else:
+        obs.track_spectrum(value - G, 0.0, 0.0)
+
+
 class WaveCoast:
     """Wave-frequency motion plus drift per NED axis, aided by GNSS (module docstring).
 
@@ -235,12 +245,7 @@ class WaveCoast:
         self.in_block = 0
         with one_blas_thread():                 # the filters' products are small (blas module)
             for obs, band, a, y in zip(self.observers, self.bands, mean, step_mean):
-                # each observer sees its axis as a level vertical: a_v = f_z + g with f_z = a − g;
-                # once it has a model, only its spectrum is used (the band filter runs the model)
-                if obs.model is None:
-                    obs.step(float(a) - G, 0.0, 0.0, self.block * self.dt)
-                else:
-                    obs.track_spectrum(float(a) - G, 0.0, 0.0)
+                observe(obs, float(a), self.block * self.dt)
                 if obs.model is not None and obs.model is not band.model:
                     first = band.model is None
                     band.follow(obs.model, obs.xp)
@@ -266,10 +271,7 @@ class WaveCoast:
         h = self.block * self.dt
         second = (self.angles[2] - 2.0 * self.angles[1] + self.angles[0]) / (h * h)
         for obs, band, i in zip(self.angle_observers, self.bands, (1, 0)):
-            if obs.model is None:
-                obs.step(float(second[i]) - G, 0.0, 0.0, h)
-            else:
-                obs.track_spectrum(float(second[i]) - G, 0.0, 0.0)
+            observe(obs, float(second[i]), h)
             if band.model is None or obs.model is None:
                 continue
             if obs.model is not self.angle_models[i]:     # a new spectrum
