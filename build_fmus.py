@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Build every models/*.py into fmus/*.fmu, add units, and validate (see marinefmu.cosim.build)."""
+"""Build every models/*.py into fmus/*.fmu, add units, and validate (see marinefmu.fmu.build)."""
 import argparse
 import sys
 
-from marinefmu.cosim.build import BuildError, build_all
+from marinefmu.fmu.build import BuildError, build_all
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__)

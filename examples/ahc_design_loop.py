@@ -14,8 +14,8 @@ Run from the repository (after ``make test`` or ``make demo`` has built the FMUs
     .venv/bin/python examples/ahc_design_loop.py --out results/ahc_example
 
 Change the sea, the crane tip or the winch in the scenario file (``--scenario``), or replace
-:func:`marinefmu.ahc_design.design` with your own tuning (LQG, H∞, …): anything that yields a
-``ControllerParams`` can be predicted, verified and written the same way.
+:func:`marinefmu.ahc.design.design` with your own tuning (LQG, H∞, …): anything that yields a
+``AhcControllerParams`` can be predicted, verified and written the same way.
 """
 from __future__ import annotations
 
@@ -23,11 +23,11 @@ import argparse
 from dataclasses import replace
 from pathlib import Path
 
-from marinefmu.ahc_design import design, fit_feedforward, predicted_residual
-from marinefmu.ahc_loop import GAINS, find_loop, identify, verify, write_gains
-from marinefmu.cosim.ahc_io import controller_params, winch_params
-from marinefmu.cosim.build import build_all, repo_root
-from marinefmu.scenarios import load_scenario
+from marinefmu.ahc.design import design, fit_feedforward, predicted_residual
+from marinefmu.ahc.loop import GAINS, find_loop, identify, verify, write_gains
+from marinefmu.fmu.ahc_tables import controller_params, winch_params
+from marinefmu.fmu.build import build_all, repo_root
+from marinefmu.cosim.scenarios import load_scenario
 
 
 def main(argv: list[str] | None = None) -> dict:

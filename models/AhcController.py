@@ -1,14 +1,14 @@
 """AhcController FMU: feedforward from the estimated crane-tip heave plus PI feedback on the
 wire length (issue 9). Thin adapter over ``marinefmu.ahc.controller``; never raises (see
-``marinefmu.cosim.slave``)."""
+``marinefmu.fmu.slave``)."""
 from pythonfmu import Fmi2Slave
 
 from marinefmu import __version__
 from marinefmu.ahc.controller import AhcController as Controller
-from marinefmu.cosim.ahc_io import (
+from marinefmu.fmu.tables import (
     CONTROLLER_BOOLEANS, CONTROLLER_INPUTS, CONTROLLER_OUTPUTS, CONTROLLER_PARAMETERS, controller_params,
 )
-from marinefmu.cosim.slave import SlaveIO
+from marinefmu.fmu.slave import SlaveIO
 
 
 if "AhcController" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun

@@ -1,12 +1,12 @@
 """AhcWinch FMU: an active-heave-compensation winch at a crane tip with a load on an elastic
 wire (issue 9). Thin adapter over ``marinefmu.ahc.winch``; never raises (see
-``marinefmu.cosim.slave``). The load starts at rest below the crane tip of the first step."""
+``marinefmu.fmu.slave``). The load starts at rest below the crane tip of the first step."""
 from pythonfmu import Fmi2Slave
 
 from marinefmu import __version__
-from marinefmu.ahc.winch import WinchLoadModel
-from marinefmu.cosim.ahc_io import WINCH_BOOLEANS, WINCH_INPUTS, WINCH_OUTPUTS, WINCH_PARAMETERS, winch_params
-from marinefmu.cosim.slave import SlaveIO
+from marinefmu.ahc.winch import AhcWinch as Model
+from marinefmu.fmu.tables import WINCH_BOOLEANS, WINCH_INPUTS, WINCH_OUTPUTS, WINCH_PARAMETERS, winch_params
+from marinefmu.fmu.slave import SlaveIO
 
 
 if "AhcWinch" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun
@@ -28,7 +28,7 @@ else:
             self.io.start_time = start_time
 
         def exit_initialization_mode(self):
-            self.model = self.io.build(lambda values: WinchLoadModel(winch_params(values)))
+            self.model = self.io.build(lambda values: Model(winch_params(values)))
             self.started = False
 
         def do_step(self, current_time, step_size):

@@ -1,14 +1,14 @@
 """AttitudeEstimator FMU: roll, pitch, yaw and quaternion from gyro and accelerometer samples
 (paper 000 quaternion integration; mode 1 adds the aided drift correction). Thin adapter over
-``marinefmu.estimators.attitude``; never raises (see ``marinefmu.cosim.slave``)."""
+``marinefmu.estimators.attitude.estimator``; never raises (see ``marinefmu.fmu.slave``)."""
 from pythonfmu import Fmi2Slave
 
 from marinefmu import __version__
-from marinefmu.cosim.estimator_io import (
+from marinefmu.fmu.tables import (
     ATTITUDE_BOOLEANS, ATTITUDE_INPUTS, ATTITUDE_OUTPUTS, ATTITUDE_PARAMETERS, attitude_params,
 )
-from marinefmu.cosim.slave import SlaveIO
-from marinefmu.estimators.attitude import AttitudeEstimator as Estimator
+from marinefmu.fmu.slave import SlaveIO
+from marinefmu.estimators.attitude.estimator import AttitudeEstimator as Estimator
 
 
 if "AttitudeEstimator" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun

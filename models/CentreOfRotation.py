@@ -1,12 +1,12 @@
 """CentreOfRotation FMU: offset from the sensor to the ship's centre of rotation by a Kalman
 filter with lever-arm states (paper 002). Thin adapter over
-``marinefmu.estimators.centre_of_rotation``; never raises (see ``marinefmu.cosim.slave``)."""
+``marinefmu.estimators.centre_of_rotation.filter``; never raises (see ``marinefmu.fmu.slave``)."""
 from pythonfmu import Fmi2Slave
 
 from marinefmu import __version__
-from marinefmu.cosim.estimator_io import CR_BOOLEANS, CR_INPUTS, CR_OUTPUTS, CR_PARAMETERS, cr_params
-from marinefmu.cosim.slave import SlaveIO
-from marinefmu.estimators.centre_of_rotation import CentreOfRotation as Estimator
+from marinefmu.fmu.tables import CR_BOOLEANS, CR_INPUTS, CR_OUTPUTS, CR_PARAMETERS, cr_params
+from marinefmu.fmu.slave import SlaveIO
+from marinefmu.estimators.centre_of_rotation.filter import CentreOfRotation as Estimator
 
 
 if "CentreOfRotation" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun

@@ -1,20 +1,20 @@
 """DisplacementReconstructor FMU: COG displacement from acceleration without integration
 (paper 000) on a sliding window. Thin adapter over
-``marinefmu.estimators.sliding_reconstruction``; never raises (see ``marinefmu.cosim.slave``)."""
+``marinefmu.estimators.reconstruction.sliding``; never raises (see ``marinefmu.fmu.slave``)."""
 from pythonfmu import Fmi2Slave
 
 from marinefmu import __version__
-from marinefmu.cosim.estimator_io import (
+from marinefmu.fmu.tables import (
     RECONSTRUCTOR_BOOLEANS, RECONSTRUCTOR_INPUTS, RECONSTRUCTOR_OUTPUTS, RECONSTRUCTOR_PARAMETERS, sliding_params,
 )
-from marinefmu.cosim.slave import SlaveIO
-from marinefmu.estimators.sliding_reconstruction import SlidingReconstructor
+from marinefmu.fmu.slave import SlaveIO
+from marinefmu.estimators.reconstruction.sliding import DisplacementReconstructor as Estimator
 
 
 def _build(values):
     params = sliding_params(values)
     params.validate(1e-3)  # refuse what is invalid at any rate now; checked against the real step later
-    return SlidingReconstructor(params)
+    return Estimator(params)
 
 
 if "DisplacementReconstructor" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun

@@ -1,15 +1,15 @@
 """GnssAccFusion FMU: four-antenna GNSS attitude corrects the accelerometer, and a multirate
 Kalman filter fuses it with the GNSS position (paper 001). Thin adapter over
-``marinefmu.estimators.gnss_fusion``; never raises (see ``marinefmu.cosim.slave``)."""
+``marinefmu.estimators.gnss_fusion.filter``; never raises (see ``marinefmu.fmu.slave``)."""
 import numpy as np
 from pythonfmu import Fmi2Slave
 
 from marinefmu import __version__
-from marinefmu.cosim.estimator_io import (
+from marinefmu.fmu.tables import (
     FUSION_BOOLEANS, FUSION_INPUTS, FUSION_OUTPUTS, FUSION_PARAMETERS, fusion_params,
 )
-from marinefmu.cosim.slave import SlaveIO
-from marinefmu.estimators.gnss_fusion import GnssAccFusion as Estimator
+from marinefmu.fmu.slave import SlaveIO
+from marinefmu.estimators.gnss_fusion.filter import GnssAccFusion as Estimator
 
 ANT_NAMES = [f"gnss.ant{i}.{a}" for i in range(1, 5) for a in "ned"]
 

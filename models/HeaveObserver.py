@@ -1,12 +1,12 @@
 """HeaveObserver FMU: heave at the IMU and at a remote point from a strapdown IMU by an adaptive
-bank of oscillator modes (paper 003). Thin adapter over ``marinefmu.estimators.heave``; never
-raises (see ``marinefmu.cosim.slave``)."""
+bank of oscillator modes (paper 003). Thin adapter over ``marinefmu.estimators.heave.observer``; never
+raises (see ``marinefmu.fmu.slave``)."""
 from pythonfmu import Fmi2Slave
 
 from marinefmu import __version__
-from marinefmu.cosim.estimator_io import HEAVE_DISCRETE, HEAVE_INPUTS, HEAVE_OUTPUTS, HEAVE_PARAMETERS, heave_params
-from marinefmu.cosim.slave import SlaveIO
-from marinefmu.estimators.highpass_heave import heave_estimator
+from marinefmu.fmu.tables import HEAVE_DISCRETE, HEAVE_INPUTS, HEAVE_OUTPUTS, HEAVE_PARAMETERS, heave_params
+from marinefmu.fmu.slave import SlaveIO
+from marinefmu.estimators.heave.observer import HeaveObserver as Estimator
 
 
 if "HeaveObserver" in globals():  # pythonfmu runs this file again for each instance: see SlaveIO.rerun
@@ -27,7 +27,7 @@ else:
             self.io.start_time = start_time
 
         def exit_initialization_mode(self):
-            self.model = self.io.build(lambda values: heave_estimator(heave_params(values)))
+            self.model = self.io.build(lambda values: Estimator(heave_params(values)))
 
         def do_step(self, current_time, step_size):
             return self.io.step(self._step, current_time, step_size)

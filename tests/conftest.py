@@ -14,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session")
 def fmu_dir() -> Path:
     """fmus/ of the checkout, with every model built and validated."""
-    from marinefmu.cosim.build import build_all
+    from marinefmu.fmu.build import build_all
 
     build_all(verbose=False)
     return ROOT / "fmus"
@@ -23,7 +23,7 @@ def fmu_dir() -> Path:
 @pytest.fixture(scope="session")
 def relay_fmu(tmp_path_factory) -> Path:
     """A test-only FMU with inputs (tests/models/MfTestRelay.py), to exercise wiring and rates."""
-    from marinefmu.cosim.build import build_all
+    from marinefmu.fmu.build import build_all
 
     dest = tmp_path_factory.mktemp("relay")
     build_all(models=ROOT / "tests" / "models", dest=dest, verbose=False)
@@ -45,8 +45,8 @@ class LibcosimBeside:
         import sys
 
         self.out = Path(work) / "libcosim.npy"
-        code = ("import os, numpy as np\nfrom marinefmu.scenarios import load_scenario\n"
-                "from marinefmu.cosim.libcosim_runner import run_libcosim\n"
+        code = ("import os, numpy as np\nfrom marinefmu.cosim.scenarios import load_scenario\n"
+                "from marinefmu.cosim.libcosim import run_libcosim\n"
                 f"out = run_libcosim(load_scenario({scenario!r}).system, {str(fmu_dir)!r}, {str(work)!r}, {duration}, "
                 f"{list(record)!r}, {sample})\nnp.save({str(self.out)!r}, out)\nos._exit(0)\n")
         self.proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,

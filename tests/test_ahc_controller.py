@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from marinefmu.ahc.controller import AhcController, ControllerParams
+from marinefmu.ahc.controller import AhcController, AhcControllerParams
 from marinefmu.errors import ParameterError
 
 
 def test_the_law_is_feedforward_plus_pi_on_the_length():
-    c = AhcController(ControllerParams(length0=20.0, k_ff=1.0, k_p=2.0, k_i=0.5, heave_ref=-10.0, engage_time=0.0))
+    c = AhcController(AhcControllerParams(length0=20.0, k_ff=1.0, k_p=2.0, k_i=0.5, heave_ref=-10.0, engage_time=0.0))
     out = c.step(heave=-9.5, heave_rate=0.3, length=19.0, dt=0.1)
     ref = 20.0 - (-9.5 + 10.0)                       # 19.5 m
     assert out.length_ref == pytest.approx(ref)
@@ -20,7 +20,7 @@ def test_the_law_is_feedforward_plus_pi_on_the_length():
 
 
 def test_bad_inputs_are_held_and_the_integrator_is_clamped():
-    c = AhcController(ControllerParams(k_i=1.0, max_integral=0.5, max_command=100.0, engage_time=0.0))
+    c = AhcController(AhcControllerParams(k_i=1.0, max_integral=0.5, max_command=100.0, engage_time=0.0))
     a = c.step(0.1, 0.2, 19.0, 0.1)
     b = c.step(math.nan, 0.2, 19.0, 0.1)
     assert not b.valid and "bad heave nan" in b.warning and math.isfinite(b.command)
@@ -31,7 +31,7 @@ def test_bad_inputs_are_held_and_the_integrator_is_clamped():
 
 
 def test_the_feedforward_fades_in_while_the_estimate_is_valid_and_out_while_not():
-    c = AhcController(ControllerParams(length0=20.0, k_ff=1.0, k_p=0.0, k_i=0.0, engage_time=2.0))
+    c = AhcController(AhcControllerParams(length0=20.0, k_ff=1.0, k_p=0.0, k_i=0.0, engage_time=2.0))
     off = c.step(1.0, 0.5, 20.0, 0.1, heave_valid=False)
     assert off.engagement == 0.0 and off.length_ref == 20.0 and off.command == 0.0 and not off.valid
     ramp = [c.step(1.0, 0.5, 20.0, 0.1) for _ in range(20)]
@@ -41,7 +41,7 @@ def test_the_feedforward_fades_in_while_the_estimate_is_valid_and_out_while_not(
     down = c.step(1.0, 0.5, 20.0, 0.1, heave_valid=False)     # one rejected estimate: 5 % off, not all
     assert down.engagement == pytest.approx(0.95) and not down.valid
     with pytest.raises(ParameterError, match=r"engage_time = -1\.0 is out of range"):
-        ControllerParams(engage_time=-1.0)
+        AhcControllerParams(engage_time=-1.0)
 
 
 @pytest.mark.parametrize("kwargs,match", [
@@ -51,7 +51,7 @@ def test_the_feedforward_fades_in_while_the_estimate_is_valid_and_out_while_not(
 ])
 def test_bad_parameters_name_the_cause(kwargs, match):
     with pytest.raises(ParameterError, match=match):
-        ControllerParams(**kwargs)
+        AhcControllerParams(**kwargs)
 
 
 @pytest.mark.fmu
@@ -82,7 +82,7 @@ def test_truth_fed_loop_holds_the_load_still_in_co_simulation(fmu_dir):
 
 
 def test_a_clipped_command_stops_the_integration_into_the_clip():
-    c = AhcController(ControllerParams(length0=20.0, k_ff=0.0, k_p=1.0, k_i=1.0, max_command=2.0, engage_time=0.0))
+    c = AhcController(AhcControllerParams(length0=20.0, k_ff=0.0, k_p=1.0, k_i=1.0, max_command=2.0, engage_time=0.0))
     out = c.step(0.0, 0.0, 15.0, 0.1)                    # 5 m short: 5 m/s asked, 2 m/s given
     assert out.command == 2.0 and out.command_limited and c.integral == 0.0
     small = c.step(0.0, 0.0, 19.5, 0.1)                   # inside the clip: integrates again

@@ -5,19 +5,19 @@ import math
 import numpy as np
 import pytest
 
-from marinefmu.ahc.winch import WinchParams
-from marinefmu.ahc_design import design, load_tf, winch_tf
+from marinefmu.ahc.winch import AhcWinchParams
+from marinefmu.ahc.design import design, load_tf, winch_tf
 from marinefmu.errors import ParameterError
 
 
 def test_design_meets_its_stated_margins():
     import control
 
-    d = design(WinchParams(tau=0.1), phase_margin=60.0)
+    d = design(AhcWinchParams(tau=0.1), phase_margin=60.0)
     assert d.phase_margin >= 60.0 and np.all(d.closed_loop_poles.real < 0)
     # the margins recomputed independently from the gains: |C P| = 1 at the crossover
     c = control.tf([d.controller.k_p, d.controller.k_i], [1.0, 0.0])
-    loop = c * winch_tf(WinchParams(tau=0.1))
+    loop = c * winch_tf(AhcWinchParams(tau=0.1))
     assert abs(complex(control.evalfr(loop, 1j * d.crossover))) == pytest.approx(1.0, rel=1e-9)
     gm, pm = control.stability_margins(loop)[:2]
     assert pm == pytest.approx(d.phase_margin, abs=1e-6)
@@ -28,7 +28,7 @@ def test_design_meets_its_stated_margins():
 def test_the_load_model_is_the_mass_on_the_wire():
     import control
 
-    w = load_tf(WinchParams())
+    w = load_tf(AhcWinchParams())
     assert abs(complex(control.evalfr(w, 0.0))) == pytest.approx(1.0)
     poles = control.poles(w)
     assert np.abs(poles[0]) == pytest.approx(10.0)              # sqrt(k/m)
@@ -38,7 +38,7 @@ def test_impossible_designs_are_refused_with_the_cause():
     with pytest.raises(ParameterError, match=r"phase_margin = 95\.0 is out of range"):
         design(phase_margin=95.0)
     with pytest.raises(ParameterError, match=r"no crossover below half the wire-load mode"):
-        design(WinchParams(order=2, omega_n=0.5, zeta=0.05), phase_margin=89.0)
+        design(AhcWinchParams(order=2, omega_n=0.5, zeta=0.05), phase_margin=89.0)
 
 
 @pytest.mark.fmu

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from conftest import LibcosimBeside
 
-from marinefmu.ahc.winch import WinchParams
-from marinefmu.ahc_design import design, fit_feedforward, identify_response, predicted_residual
-from marinefmu.ahc_loop import find_loop, subsystem, write_gains
+from marinefmu.ahc.winch import AhcWinchParams
+from marinefmu.ahc.design import design, fit_feedforward, identify_response, predicted_residual
+from marinefmu.ahc.loop import find_loop, subsystem, write_gains
 from marinefmu.errors import ParameterError
-from marinefmu.scenarios import load_scenario
+from marinefmu.cosim.scenarios import load_scenario
 
 DT = 0.01
 
@@ -56,7 +56,7 @@ def test_the_fitted_feedforward_gain_is_the_best_one():
     k_ff either way predicts more residual (for an estimator that overestimates by 2 %)."""
     t, x, v, *_ = _sea()
     r = identify_response(x, 1.02 * x, 1.02 * v, DT)
-    winch = WinchParams(max_speed=3.0, max_acc=3.0)
+    winch = AhcWinchParams(max_speed=3.0, max_acc=3.0)
     best = fit_feedforward(r, winch, design(winch).controller, DT)
     truth = fit_feedforward(identify_response(x, x, v, DT), winch, design(winch).controller, DT)
     assert best.k_ff == pytest.approx(truth.k_ff / 1.02, rel=1e-3)   # the loop's own optimum (0.985), scaled
@@ -109,7 +109,7 @@ def test_four_ways_to_drive_the_winch_against_the_goals(fmu_dir):
     this run's identified observer to 15 % (predicted 1.00 % and 1.03 %; 1.04 % and 1.02 %
     before)."""
     from marinefmu.cosim.system import SystemRunner
-    from marinefmu.scoring import score
+    from marinefmu.analysis.scoring import score
 
     sc = load_scenario("ahc")
     r = SystemRunner(sc.system, fmu_dir).run(sc.duration, record=sc.record, progress=False)
@@ -127,7 +127,7 @@ def test_four_ways_to_drive_the_winch_against_the_goals(fmu_dir):
     m = r["time"] >= 420.0
     resp = identify_response(r["vessel.truth.point.d"][m], r["heave.point.heave"][m], r["heave.point.heave_rate"][m], DT)
     comps = {c.name: c for c in sc.system.components}
-    from marinefmu.cosim.ahc_io import controller_params, winch_params
+    from marinefmu.fmu.tables import controller_params, winch_params
 
     winch, ctrl = winch_params(comps["winch_observer"].parameters), controller_params(comps["ctrl_observer"].parameters)
     assert 100 * predicted_residual(resp, winch, ctrl, DT) == pytest.approx(obs["residual_pct"], rel=0.15)
@@ -155,7 +155,7 @@ def test_design_ahc_identifies_tunes_verifies_and_writes_the_gains(fmu_dir, tmp_
     written = tomllib.loads((tmp_path / "ahc.toml").read_text())["components"]
     gains = [(written[c]["parameters"]["k_p"], written[c]["parameters"]["k_ff"]) for c in
              ("ctrl_ideal", "ctrl_classic", "ctrl_observer")]
-    assert len(set(gains)) == 1 and gains[0][0] == pytest.approx(design(WinchParams()).controller.k_p, rel=1e-4)
+    assert len(set(gains)) == 1 and gains[0][0] == pytest.approx(design(AhcWinchParams()).controller.k_p, rel=1e-4)
     assert 0.9 < gains[0][1] < 1.1
 
 

@@ -4,15 +4,15 @@ import math
 import numpy as np
 import pytest
 
-from marinefmu.ahc.winch import G, WinchLoadModel, WinchParams
+from marinefmu.ahc.winch import G, AhcWinch, AhcWinchParams
 from marinefmu.errors import ParameterError
 
 
 def test_load_rings_as_the_damped_mass_on_a_spring():
     """Winch held, tip still, load released 5 cm above its rest point: z(t) − z_eq is the
     damped oscillation of m z̈ + c ż + k z = 0 (ω = √(k/m) = 10 rad/s, ζ = c/(2√(km)) = 0.05)."""
-    p = WinchParams()
-    m = WinchLoadModel(p)
+    p = AhcWinchParams()
+    m = AhcWinch(p)
     z_eq = m.x[3]
     m.x[3] -= 0.05
     w, zeta = math.sqrt(p.stiffness / p.mass), p.damping / (2.0 * math.sqrt(p.stiffness * p.mass))
@@ -33,8 +33,8 @@ def test_exact_linear_step_agrees_with_rk4_and_yields_to_it_near_a_limit(order):
     once with RK4 on every step: the same motion to 1e-8 m (measured 5e-10 for order 1, 2e-9 for
     order 2: RK4's own error at 2 ms substeps), the same flags. A command past the speed limit
     with a tight acceleration limit takes RK4 (the limit acts) and flags it."""
-    p = WinchParams(order=order, zeta=0.5)
-    exact, rk4 = WinchLoadModel(p), WinchLoadModel(p)
+    p = AhcWinchParams(order=order, zeta=0.5)
+    exact, rk4 = AhcWinch(p), AhcWinch(p)
     rk4._in_linear_regime = lambda *args: False
     used = []
     original = exact._linear_step
@@ -48,7 +48,7 @@ def test_exact_linear_step_agrees_with_rk4_and_yields_to_it_near_a_limit(order):
         assert a.tension == pytest.approx(b.tension, abs=1e-2)
         assert (a.acc_limited, a.slack, a.stroke_limited) == (b.acc_limited, b.slack, b.stroke_limited)
     assert 5980 <= len(used) < 6000      # all but the first steps, where the command's jump meets the acceleration limit
-    limited = WinchLoadModel(WinchParams(order=order, max_acc=0.5))
+    limited = AhcWinch(AhcWinchParams(order=order, max_acc=0.5))
     used.clear()
     limited._linear_step = lambda dt: used.append(dt) or original(dt)
     for _ in range(50):
@@ -59,8 +59,8 @@ def test_exact_linear_step_agrees_with_rk4_and_yields_to_it_near_a_limit(order):
 
 def test_first_order_motor_follows_a_speed_step():
     """v(t) = u (1 − e^{−t/τ}), L(t) = L₀ + u (t − τ (1 − e^{−t/τ})) below the limits."""
-    p = WinchParams(tau=0.2, max_acc=10.0)
-    m = WinchLoadModel(p)
+    p = AhcWinchParams(tau=0.2, max_acc=10.0)
+    m = AhcWinch(p)
     for k in range(1, 101):
         s = m.step(0.5, 0.0, 0.0, 0.01)
         t = k * 0.01
@@ -70,8 +70,8 @@ def test_first_order_motor_follows_a_speed_step():
 
 
 def test_second_order_motor_step_settles_with_its_overshoot():
-    p = WinchParams(order=2, omega_n=10.0, zeta=0.5, max_acc=100.0)
-    m = WinchLoadModel(p)
+    p = AhcWinchParams(order=2, omega_n=10.0, zeta=0.5, max_acc=100.0)
+    m = AhcWinch(p)
     v = [m.step(1.0, 0.0, 0.0, 0.01).speed for _ in range(300)]
     overshoot = max(v) - 1.0
     assert overshoot == pytest.approx(math.exp(-math.pi * 0.5 / math.sqrt(1 - 0.25)), rel=1e-3)   # 16.3 %
@@ -79,8 +79,8 @@ def test_second_order_motor_step_settles_with_its_overshoot():
 
 
 def test_limits_act_and_are_flagged():
-    p = WinchParams(max_speed=1.0, max_acc=0.5, max_length=20.5)
-    m = WinchLoadModel(p)
+    p = AhcWinchParams(max_speed=1.0, max_acc=0.5, max_length=20.5)
+    m = AhcWinch(p)
     s = m.step(3.0, 0.0, 0.0, 0.1)
     assert s.speed_limited and s.acc_limited
     assert s.speed == pytest.approx(0.05, abs=1e-9)          # 0.5 m/s² for 0.1 s
@@ -92,7 +92,7 @@ def test_limits_act_and_are_flagged():
 def test_a_tip_dropping_faster_than_the_load_can_fall_slackens_the_wire():
     """The tip drops at 4 m/s from rest: the load cannot follow faster than free fall, the
     wire goes slack (tension 0, flagged, never negative) and takes the load again."""
-    m = WinchLoadModel(WinchParams())
+    m = AhcWinch(AhcWinchParams())
     slack, tensions = [], []
     for k in range(100):
         s = m.step(0.0, 4.0 * (k + 1) * 0.01, 4.0, 0.01)
@@ -102,7 +102,7 @@ def test_a_tip_dropping_faster_than_the_load_can_fall_slackens_the_wire():
 
 
 def test_at_rest_the_wire_carries_the_load():
-    m = WinchLoadModel(WinchParams(), tip=-12.0)
+    m = AhcWinch(AhcWinchParams(), tip=-12.0)
     s = m.step(0.0, -12.0, 0.0, 1.0)
     assert s.tension == pytest.approx(1.0e4 * G) and s.load == pytest.approx(-12.0 + 20.0 + 1.0e4 * G / 1.0e6)
 
@@ -116,12 +116,12 @@ def test_at_rest_the_wire_carries_the_load():
 ])
 def test_bad_parameters_name_the_cause(kwargs, match):
     with pytest.raises(ParameterError, match=match):
-        WinchParams(**kwargs)
+        AhcWinchParams(**kwargs)
 
 
 def test_a_bad_input_is_held_flagged_and_never_passed_on():
-    good = WinchLoadModel(WinchParams())
-    bad = WinchLoadModel(WinchParams())
+    good = AhcWinch(AhcWinchParams())
+    bad = AhcWinch(AhcWinchParams())
     for k in range(50):
         tip = 0.1 * math.sin(0.5 * k * 0.01)
         a = good.step(0.2, tip, 0.0, 0.01)
@@ -131,7 +131,7 @@ def test_a_bad_input_is_held_flagged_and_never_passed_on():
         assert all(math.isfinite(v) for v in (b.length, b.load, b.load_vel, b.tension))
     assert abs(a.load - b.load) < 1e-3          # one held step changes little
     state = bad.get_state()
-    again = WinchLoadModel(WinchParams())
+    again = AhcWinch(AhcWinchParams())
     again.set_state(state)
     assert again.step(0.2, 0.0, 0.0, 0.01) == bad.step(0.2, 0.0, 0.0, 0.01)
 
@@ -139,7 +139,7 @@ def test_a_bad_input_is_held_flagged_and_never_passed_on():
 @pytest.mark.fmu
 def test_fmu_equals_the_in_process_model_under_vessel_motion(fmu_dir):
     """AhcWinch.fmu hanging off VesselMotion's bow point (FMPy runner, no command): the same
-    numbers as WinchLoadModel fed the recorded tip motion (Jacobi: the inputs of step k are
+    numbers as AhcWinch fed the recorded tip motion (Jacobi: the inputs of step k are
     the vessel's outputs at row k)."""
     from marinefmu.cosim.ssp import Component, Connection, SystemDescription
     from marinefmu.cosim.system import SystemRunner
@@ -151,7 +151,7 @@ def test_fmu_equals_the_in_process_model_under_vessel_motion(fmu_dir):
     r = SystemRunner(sysd, fmu_dir).run(record=["vessel.truth.point.d", "vessel.truth.point_vel.d", "winch.load.d",
                                                 "winch.tension", "winch.length", "winch.valid", "winch.slack"],
                                         progress=False)
-    m = WinchLoadModel(WinchParams(mass=5.0e3), tip=float(r["vessel.truth.point.d"][0]))
+    m = AhcWinch(AhcWinchParams(mass=5.0e3), tip=float(r["vessel.truth.point.d"][0]))
     load = [m.step(0.0, float(r["vessel.truth.point.d"][k]), float(r["vessel.truth.point_vel.d"][k]), 0.01).load
             for k in range(len(r) - 1)]
     np.testing.assert_array_equal(r["winch.load.d"][1:], load)

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from filterpy.kalman import KalmanFilter
 
-from marinefmu.estimators.aided_band import FIX_SIGMA, AidedBand, Tilt, blocks_times, drift_noise
-from marinefmu.estimators.band_bank import band_grid, build_band_bank
-from marinefmu.estimators.wave_coast import SPECTRUM_WINDOW, WaveCoast
+from marinefmu.estimators.gnss_fusion.aided_band import FIX_SIGMA, AidedBand, Tilt, blocks_times, drift_noise
+from marinefmu.estimators.heave.band_bank import band_grid, build_band_bank
+from marinefmu.estimators.gnss_fusion.wave_coast import SPECTRUM_WINDOW, WaveCoast
 from marinefmu.frames import rot_nb
 
 DT = 0.05

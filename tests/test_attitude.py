@@ -8,11 +8,11 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.attitude import (
-    AttitudeEstimator, AttitudeParams, estimate_attitude, integrate_gyro, integrate_gyro_euler,
+from marinefmu.estimators.attitude.estimator import (
+    AttitudeEstimator, AttitudeEstimatorParams, estimate_attitude, integrate_gyro, integrate_gyro_euler,
 )
 from marinefmu.frames import G, euler_to_quat, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
-from marinefmu.sea.motion_model import REAL_INDEX, VesselMotionModel, VesselMotionParams
+from marinefmu.sea.motion_model import REAL_INDEX, VesselMotion, VesselMotionParams
 
 rng = np.random.default_rng(11)
 ANGLES = rng.uniform([-0.6, -0.5, -3.0], [0.6, 0.5, 3.0], size=(10, 3))
@@ -56,7 +56,7 @@ def vessel_record(seconds, noise, **extra):
         values.update({"imu.acc_noise": 0.0, "imu.gyro_noise": 0.0, "imu.acc_bias_instability": 0.0,
                        "imu.gyro_bias_instability": 0.0})
     values.update(extra)
-    m = VesselMotionModel(VesselMotionParams.from_flat(values))
+    m = VesselMotion(VesselMotionParams.from_flat(values))
     y = np.array([m.step((k + 1) * 0.01, 0.01) for k in range(int(seconds / 0.01))])
     get = lambda names: y[:, [REAL_INDEX[n] for n in names]]  # noqa: E731
     return get([f"imu.gyro.{a}" for a in "xyz"]), get([f"imu.acc.{a}" for a in "xyz"]), get(["truth.roll", "truth.pitch", "truth.yaw"])
@@ -65,7 +65,7 @@ def vessel_record(seconds, noise, **extra):
 def test_gyro_only_tracks_noise_free_truth():
     gyro, acc, truth = vessel_record(120.0, noise=False)
     # the first sample is at t = dt: start from the truth there and integrate the rest
-    r = estimate_attitude(gyro[1:], acc[1:], 0.01, AttitudeParams(mode=0, init="given", init_euler=tuple(truth[0])))
+    r = estimate_attitude(gyro[1:], acc[1:], 0.01, AttitudeEstimatorParams(mode=0, init="given", init_euler=tuple(truth[0])))
     err = np.c_[r["roll"], r["pitch"], r["yaw"]] - truth[1:]
     # trapezoidal rates: O(dt²) per step on wave-frequency rotation; 2e-6 rad = 1e-4 deg
     assert np.max(np.abs(err)) < 2e-6
@@ -75,20 +75,20 @@ def test_aided_mode_estimates_a_constant_gyro_bias_at_rest():
     bias = np.array([2e-3, -1.5e-3, 0.0])
     roll, pitch = 0.05, -0.03
     f = rot_nb(roll, pitch, 0.0).T @ np.array([0.0, 0.0, -G])
-    est = AttitudeEstimator(AttitudeParams(init="given", init_euler=(roll, pitch, 0.0), vel_sigma=0.1, pos_sigma=0.1))
+    est = AttitudeEstimator(AttitudeEstimatorParams(init="given", init_euler=(roll, pitch, 0.0), vel_sigma=0.1, pos_sigma=0.1))
     for _ in range(60000):  # 600 s
         r = est.step(bias, f, 0.01)
     np.testing.assert_allclose(r.gyro_bias[:2], bias[:2], rtol=0.02)
     assert abs(r.roll - roll) < math.radians(0.01) and abs(r.pitch - pitch) < math.radians(0.01)
     gyro_only = estimate_attitude(np.tile(bias, (60000, 1)), np.tile(f, (60000, 1)), 0.01,
-                                  AttitudeParams(mode=0, init="given", init_euler=(roll, pitch, 0.0)))
+                                  AttitudeEstimatorParams(mode=0, init="given", init_euler=(roll, pitch, 0.0)))
     assert abs(gyro_only["roll"][-1] - roll) > 1.0  # 2e-3 rad/s for 600 s: 1.2 rad of drift
 
 
 def test_levelling_from_a_static_tilt():
     roll, pitch = 0.1, -0.05
     f = rot_nb(roll, pitch, 0.0).T @ np.array([0.0, 0.0, -G])
-    est = AttitudeEstimator(AttitudeParams(init="level", level_time=1.0))
+    est = AttitudeEstimator(AttitudeEstimatorParams(init="level", level_time=1.0))
     results = [est.step(np.zeros(3), f, 0.01) for _ in range(101)]
     assert not any(r.valid for r in results[:100]) and results[100].valid
     assert abs(results[100].roll - roll) < 1e-12 and abs(results[100].pitch - pitch) < 1e-12
@@ -98,14 +98,14 @@ def test_drift_corrected_roll_pitch_on_the_semisub():
     """Noise-free sensors: the aided filter keeps roll/pitch within the 0.02° goal; with the
     default MEMS noise (10°/h gyro bias instability) it reaches 0.07° (README, issue note)."""
     gyro, acc, truth = vessel_record(600.0, noise=False)
-    r = estimate_attitude(gyro, acc, 0.01, AttitudeParams(init_euler=(0.0, 0.0, float(truth[0, 2]))))
+    r = estimate_attitude(gyro, acc, 0.01, AttitudeEstimatorParams(init_euler=(0.0, 0.0, float(truth[0, 2]))))
     s = slice(20000, None)  # after levelling and convergence
     rms = np.degrees(np.sqrt(np.mean((np.c_[r["roll"], r["pitch"]][s] - truth[s, :2]) ** 2, axis=0)))
     assert np.all(rms < 0.02), rms
 
 
 def test_bad_samples_coast_and_invalidate_without_nan():
-    est = AttitudeEstimator(AttitudeParams(init="given"))
+    est = AttitudeEstimator(AttitudeEstimatorParams(init="given"))
     f = np.array([0.0, 0.0, -G])
     est.step([0.0, 0.0, 0.01], f, 0.01)
     for bad in ([np.nan, 0.0, 0.0], [0.0, np.inf, 0.0], [50.0, 0.0, 0.0]):
@@ -125,17 +125,17 @@ def test_bad_samples_coast_and_invalidate_without_nan():
 ])
 def test_invalid_parameters_are_refused_by_name(kwargs, match):
     with pytest.raises(ParameterError, match=match):
-        AttitudeParams(**kwargs)
+        AttitudeEstimatorParams(**kwargs)
 
 
 def test_state_round_trip_through_json_reproduces_the_run():
     gyro, acc, _ = vessel_record(20.0, noise=True)
-    a = AttitudeEstimator(AttitudeParams(level_time=2.0))
+    a = AttitudeEstimator(AttitudeEstimatorParams(level_time=2.0))
     for k in range(1000):
         a.step(gyro[k], acc[k], 0.01)
     saved = json.loads(json.dumps(a.get_state()))
     first = [a.step(gyro[k], acc[k], 0.01) for k in range(1000, 2000)]
-    b = AttitudeEstimator(AttitudeParams(level_time=2.0))
+    b = AttitudeEstimator(AttitudeEstimatorParams(level_time=2.0))
     b.set_state(saved)
     second = [b.step(gyro[k], acc[k], 0.01) for k in range(1000, 2000)]
     assert [r.q for r in first] == [r.q for r in second]

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from marinefmu.bench_system import peak_rss_mb
+from marinefmu.bench.system import peak_rss_mb
 
 
 def test_a_worker_reports_its_own_peak_not_its_parents():
@@ -15,7 +15,7 @@ def test_a_worker_reports_its_own_peak_not_its_parents():
     VmHWM starts afresh at exec."""
     held = np.ones(300 * 2**20 // 8)                       # 300 MB resident in this process
     assert peak_rss_mb() > 300.0
-    code = "from marinefmu.bench_system import peak_rss_mb; print(peak_rss_mb())"
+    code = "from marinefmu.bench.system import peak_rss_mb; print(peak_rss_mb())"
     child = float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout)
     assert 1.0 < child < 150.0, child                      # a bare interpreter and this module: ~20-80 MB
     assert held[-1] == 1.0
@@ -30,7 +30,7 @@ def test_idle_fmus_have_the_variables_of_the_real_ones_and_do_nothing(fmu_dir, t
 
     from fmpy import read_model_description
 
-    from marinefmu.bench_system import idle_fmus
+    from marinefmu.bench.system import idle_fmus
     from marinefmu.cosim.ssp import Component, Connection, SystemDescription
     from marinefmu.cosim.system import SystemRunner
 

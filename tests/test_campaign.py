@@ -126,7 +126,7 @@ def test_the_runs_are_the_grid_times_the_sets_with_stable_ids(tmp_path, fmu_dir)
 @pytest.mark.isolated(timeout=600)
 def test_a_local_cluster_runs_the_grid_records_a_failure_and_resumes(spec_file, tmp_path, fmu_dir):
     from marinefmu.cosim.system import SystemRunner
-    from marinefmu.scoring import COMMON_METRICS, METRICS, score
+    from marinefmu.analysis.scoring import COMMON_METRICS, METRICS, score
 
     spec = load_spec(spec_file, fmu_dir)
     out = tmp_path / "out"
@@ -226,7 +226,7 @@ def test_the_cli_refuses_a_bad_spec_and_a_bad_worker_count(spec_file, fmu_dir, c
 def test_the_cli_runs_a_campaign_of_an_ssp_package_and_draws_its_map_and_comparison(tmp_path, fmu_dir, capsys):
     from marinefmu.cli import main
     from marinefmu.cosim.ssp import write_ssp
-    from marinefmu.scenarios import parse_scenario
+    from marinefmu.cosim.scenarios import parse_scenario
 
     write_ssp(parse_scenario(SCENARIO).system, fmu_dir, tmp_path / "att_only.ssp")   # the system with its FMUs
     spec = tmp_path / "maps.toml"

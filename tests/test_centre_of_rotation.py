@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from marinefmu.errors import MarineFmuError
-from marinefmu.estimators.centre_of_rotation import (
+from marinefmu.estimators.centre_of_rotation.filter import (
     CentreOfRotation, CentreOfRotationParams, eq11_specific_force, leaky_angle_step, lever_matrix,
     predicted_specific_force,
 )
-from marinefmu.estimators.centred_window import CentredWindow
-from marinefmu.examples import paper002
+from marinefmu.estimators.centre_of_rotation.centred_window import CentredWindow
+from marinefmu.papers import paper002
 from marinefmu.frames import G, attitude_kinematics, body_to_euler_rates, euler_rates_to_body, rot_nb
 
 # 8th-order central difference for a second derivative (truncation ~h^8, round-off ~1e-11 here)

@@ -1,6 +1,6 @@
 """``marinefmu example``: the list, an unknown name, and one example run end to end."""
 from marinefmu.cli import main
-from marinefmu.examples.registry import EXAMPLES
+from marinefmu.papers.registry import EXAMPLES
 
 
 def test_list_names_every_example(capsys):
@@ -27,7 +27,7 @@ def test_heave_example_beats_the_paper_modes_and_the_high_pass_baseline(tmp_path
     """Paper 003 example, shortened to 5 min: the default band observer is more accurate at the
     bow point than the paper's modes and the classical high-pass integration (README figures
     over 12 min: band 1.0 cm, modes 4-5 cm, high-pass 13 cm at the IMU), and the plot is written."""
-    from marinefmu.examples import paper003
+    from marinefmu.papers import paper003
 
     r = paper003.compare(duration=300.0)
     runs = r["runs"]

@@ -8,10 +8,10 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from marinefmu.cosim.estimator_io import attitude_params, sliding_params
-from marinefmu.estimators.attitude import AttitudeEstimator
-from marinefmu.estimators.sliding_reconstruction import SlidingReconstructor
-from marinefmu.examples import paper000_semisub
+from marinefmu.fmu.tables import attitude_params, sliding_params
+from marinefmu.estimators.attitude.estimator import AttitudeEstimator
+from marinefmu.estimators.reconstruction.sliding import DisplacementReconstructor
+from marinefmu.papers import paper000_semisub
 
 DT = 0.01
 
@@ -52,7 +52,7 @@ def test_reconstructor_fmu_equals_in_process(fmu_dir, tmp_path, record):
     params = {"window": 70.0, "hop": 5.0, "cutoff": 0.04, "lever_arm.x": 41.0, "lever_arm.y": 35.0, "lever_arm.z": -35.0}
     f = Driver(fmu_dir / "DisplacementReconstructor.fmu", tmp_path, "rec")
     f.init(params)
-    est = SlidingReconstructor(sliding_params(params))
+    est = DisplacementReconstructor(sliding_params(params))
     outs = ["disp.n", "disp.e", "disp.d", "centred.disp.n", "centred.disp.e", "centred.disp.d", "latency"]
     for k in range(7600):
         a, e = record["acc"][k], record["euler"][k]

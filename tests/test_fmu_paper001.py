@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from conftest import DT, Driver
 
-from marinefmu.cosim.estimator_io import fusion_params
-from marinefmu.estimators.gnss_fusion import GnssAccFusion
-from marinefmu.examples import paper001
+from marinefmu.fmu.tables import fusion_params
+from marinefmu.estimators.gnss_fusion.filter import GnssAccFusion
+from marinefmu.papers import paper001
 
 ANT_IN = [f"gnss.ant{i}.{a}" for i in range(1, 5) for a in "ned"]
 

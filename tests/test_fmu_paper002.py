@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from conftest import DT, Driver
 
-from marinefmu.cosim.estimator_io import cr_params
-from marinefmu.estimators.centre_of_rotation import CentreOfRotation
-from marinefmu.examples import paper002
+from marinefmu.fmu.tables import cr_params
+from marinefmu.estimators.centre_of_rotation.filter import CentreOfRotation
+from marinefmu.papers import paper002
 
 OUTS = ["offset.x", "offset.y", "offset.z", "offset_std.z", "cr.x", "acc_cr.z", "acc_cr_n.d", "roll_used", "delay"]
 

@@ -1,4 +1,4 @@
-"""HeaveObserver FMU run by FMPy equals the in-process observer bit for bit (with a NaN sample),
+"""OscillatorBankHeave FMU run by FMPy equals the in-process observer bit for bit (with a NaN sample),
 and saves/restores its state."""
 import math
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from conftest import DT, Driver
 
-from marinefmu.cosim.estimator_io import heave_params
-from marinefmu.estimators.heave import HeaveObserver
-from marinefmu.estimators.wiener_heave import WienerHeave
+from marinefmu.fmu.tables import heave_params
+from marinefmu.estimators.heave.bank import OscillatorBankHeave
+from marinefmu.estimators.heave.wiener import WienerHeave
 
 OUTS = ["heave", "heave_rate", "point.heave", "point.heave_rate", "delayed.heave", "delayed.point.heave",
         "delayed.delay", "offset", "peak_period"]
@@ -43,7 +43,7 @@ def _run_beside(f, est, steps, nan_at):
 def test_heave_fmu_equals_in_process(fmu_dir, tmp_path):
     f = Driver(fmu_dir / "HeaveObserver.fmu", tmp_path, "heave")
     f.init(PARAMS)
-    obs = HeaveObserver(heave_params(PARAMS))
+    obs = OscillatorBankHeave(heave_params(PARAMS))
     flags = _run_beside(f, obs, 5500, 5000)[1]
     assert f.fmu.getInteger([f.vr["modes"].valueReference]) == [obs._result.modes] and obs._result.modes >= 2
     assert all(flags)

@@ -10,7 +10,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from marinefmu.sea.motion_model import BOOLEAN_OUTPUTS, PARAMETERS, REAL_OUTPUTS, VesselMotionModel, VesselMotionParams
+from marinefmu.sea.motion_model import BOOLEAN_OUTPUTS, PARAMETERS, REAL_OUTPUTS, VesselMotion, VesselMotionParams
 
 pytestmark = pytest.mark.fmu
 DT = 0.01
@@ -49,7 +49,7 @@ class Fmu:
 
 
 def in_process(params, n):
-    m = VesselMotionModel(VesselMotionParams.from_flat(params))
+    m = VesselMotion(VesselMotionParams.from_flat(params))
     # the FMU computes its time as current_time + step_size: do exactly the same
     return [(m.step(k * DT + DT, DT), m.boolean_outputs()) for k in range(n)]
 

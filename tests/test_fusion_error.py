@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from marinefmu.estimators import fusion_error
-from marinefmu.estimators.fusion_error import FusionError, pi_gains
-from marinefmu.estimators.antenna_attitude import antenna_attitude_std
-from marinefmu.estimators import gnss_fusion
-from marinefmu.estimators.gnss_fusion import FusionParams, GnssAccFusion, process_noise, transition
-from marinefmu.examples import paper001
+from marinefmu.estimators.gnss_fusion import error_model as fusion_error
+from marinefmu.estimators.gnss_fusion.error_model import FusionError, pi_gains
+from marinefmu.estimators.gnss_fusion.antenna_attitude import antenna_attitude_std
+from marinefmu.estimators.gnss_fusion import filter as gnss_fusion
+from marinefmu.estimators.gnss_fusion.filter import GnssAccFusionParams, GnssAccFusion, process_noise, transition
+from marinefmu.papers import paper001
 
 
 def run(est: GnssAccFusion, rec: dict, ks: range) -> np.ndarray:
@@ -49,7 +49,7 @@ def test_with_the_filters_own_noises_it_is_the_filters_covariance(monkeypatch):
     monkeypatch.setattr(gnss_fusion, "antenna_attitude_std", lambda *a: np.full(3, 1e-12))
     p = paper001.params(coast="inertial")
     sigma = 2.0 * math.sqrt(p.r / paper001.DT)
-    est = GnssAccFusion(FusionParams(antennas=p.antennas, acc_lever_arm=p.acc_lever_arm, coast="inertial",
+    est = GnssAccFusion(GnssAccFusionParams(antennas=p.antennas, acc_lever_arm=p.acc_lever_arm, coast="inertial",
                                      acc_noise=math.sqrt(p.q), antenna_sigma_h=sigma, antenna_sigma_v=sigma,
                                      gyro_noise=1e-12, gyro_bias_sigma=1e-12))
     rec = paper001.simulate(30.0, {"gnss.rate": 5.0})
@@ -66,7 +66,7 @@ def test_the_attitude_loop_variance_matches_a_monte_carlo_of_the_pi_loop():
     """Step 2's covariance of the PI attitude loop against 4000 simulated loops of one axis:
     gyro white noise (5e-5 rad/s/√Hz, per sample N/√Δt at 100 Hz) and Gauss-Markov bias
     (5e-5 rad/s, 50 s), fixes once a second with 1.9 mrad noise, pulled with k_p = 2/τ and
-    k_i = 1/τ² (τ 30 s) as :func:`~marinefmu.estimators.gnss_fusion.pi_pull`. After 300 s the
+    k_i = 1/τ² (τ 30 s) as :func:`~marinefmu.estimators.gnss_fusion.filter.pi_pull`. After 300 s the
     attitude error's variance before and after a pull agrees to 5 % (the Monte Carlo's own
     scatter: √(2/4000) = 2.2 %)."""
     rng = np.random.default_rng(7)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from marinefmu.examples.gap_bound import prepare, row
+from marinefmu.papers.gap_bound import prepare, row
 
 DT = 0.01
 

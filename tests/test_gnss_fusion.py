@@ -8,12 +8,12 @@ from filterpy.kalman import KalmanFilter
 from scipy.spatial.transform import Rotation
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.antenna_attitude import DEFAULT_ANTENNAS, antenna_attitude, antenna_attitude_std
-from marinefmu.estimators.fusion_runs import fuse, fuse_receiver
-from marinefmu.estimators.gnss_fusion import FusionParams, GnssAccFusion, process_noise, transition
-from marinefmu.estimators.integration import integrate_frequency, integrate_time
-from marinefmu.estimators.wave_coast import WaveCoast, coast_floor
-from marinefmu.examples import paper001
+from marinefmu.estimators.gnss_fusion.antenna_attitude import DEFAULT_ANTENNAS, antenna_attitude, antenna_attitude_std
+from marinefmu.estimators.gnss_fusion.runs import fuse, fuse_receiver
+from marinefmu.estimators.gnss_fusion.filter import GnssAccFusionParams, GnssAccFusion, process_noise, transition
+from marinefmu.estimators.numerics import integrate_frequency, integrate_time
+from marinefmu.estimators.gnss_fusion.wave_coast import WaveCoast, coast_floor
+from marinefmu.papers import paper001
 from marinefmu.frames import euler_to_quat, quat_to_rot
 
 ARMS = np.array(DEFAULT_ANTENNAS)
@@ -81,7 +81,7 @@ def test_antenna_attitude_std_matches_a_monte_carlo_of_the_fit():
 ])
 def test_bad_epochs_are_skipped_with_a_reason_and_the_filter_coasts(positions, reason):
     assert reason in antenna_attitude(positions, ARMS)
-    est = GnssAccFusion(FusionParams(propagation="hold"))
+    est = GnssAccFusion(GnssAccFusionParams(propagation="hold"))
     est.step([0.0, 0.0, -9.80665], ARMS, 0.01)
     r = est.step([0.0, 0.0, -9.80665], positions, 0.01)
     assert r.fix == "skipped" and reason in r.warning and not r.valid  # flagged on that step (contract)
@@ -106,11 +106,11 @@ def test_bad_epochs_are_skipped_with_a_reason_and_the_filter_coasts(positions, r
 ])
 def test_invalid_settings_are_refused_by_name(kwargs, match):
     with pytest.raises(ParameterError, match=match):
-        FusionParams(**kwargs)
+        GnssAccFusionParams(**kwargs)
 
 
 def test_bad_accelerometer_sample_coasts_without_nan():
-    est = GnssAccFusion(FusionParams(propagation="hold"))
+    est = GnssAccFusion(GnssAccFusionParams(propagation="hold"))
     est.step([0.0, 0.0, -9.80665], ARMS, 0.01)
     r = est.step([math.nan, 0.0, -9.80665], None, 0.01)
     assert not r.valid and "bad accelerometer" in r.warning and np.all(np.isfinite(r.pos + r.vel + r.acc_n))
@@ -172,7 +172,7 @@ def test_paper_mode_equals_a_plain_filterpy_run_of_eqs_13_to_19():
     # common-mode GNSS noise keeps the antenna attitude exactly level (R = I, as the paper assumes)
     gnss = (pos[:, None, :] + ARMS[None] + rng.normal(size=(n, 1, 3)) * 0.01).reshape(n, 12)
     new = (np.arange(n) + 1) % 20 == 0
-    p = FusionParams(q=q, r=r, gate=math.inf, bias_states=False, attitude_correction=False, propagation="hold",
+    p = GnssAccFusionParams(q=q, r=r, gate=math.inf, bias_states=False, attitude_correction=False, propagation="hold",
                      step_input="latest")
     ours = fuse(f_b, dt, gnss, new, params=p)
     kf = KalmanFilter(dim_x=6, dim_z=3)
@@ -382,7 +382,7 @@ def test_without_a_coast_the_position_is_held_after_max_coast():
     """``coast="inertial"``: after ``max_coast`` without a fix the filter stops predicting
     (an inertial coast is kilometres off after minutes): its position state stays put and its
     velocity state is zero, ``valid`` false; the first fix re-initialises at rest."""
-    est = GnssAccFusion(FusionParams(coast="inertial", max_coast=5.0))
+    est = GnssAccFusion(GnssAccFusionParams(coast="inertial", max_coast=5.0))
     rng = np.random.default_rng(0)
     f_b = [0.0, 0.0, -9.80665]
     for _ in range(300):                                 # 3 s of fixes at 100 Hz
@@ -404,7 +404,7 @@ def test_pi_integral_after_a_gap_longer_than_tau_removes_the_bias_once():
     """A constant gyro bias error δb over a 300 s gap leaves an attitude error δb·300; the PI's
     integral gain dt/τ² (τ = 30 s) would take 10·δb·300 off the bias: capped at 1/dt, it takes
     δb exactly."""
-    from marinefmu.estimators.gnss_fusion import pi_pull
+    from marinefmu.estimators.gnss_fusion.filter import pi_pull
     db = np.array([2e-5, -1e-5, 3e-5])
     q = Rotation.from_rotvec(db * 300.0).as_quat(scalar_first=True)    # R_nb drifted by δb·300
     q2, bias = pi_pull(q, np.zeros(3), np.eye(3), 300.0, 30.0)
@@ -474,7 +474,7 @@ def test_q_down_sets_the_down_axis_process_noise_only():
     assert q[2, 2] == pytest.approx(1e-6 * dt ** 3 / 3) and q[5, 5] == pytest.approx(1e-6 * dt)
     assert q[2, 5] == pytest.approx(1e-6 * dt ** 2 / 2)
     with pytest.raises(ParameterError, match=r"q_down = -1\.0 is out of range"):
-        FusionParams(q_down=-1.0)
+        GnssAccFusionParams(q_down=-1.0)
 
 
 def test_one_receiver_fusion_returns_the_fix_of_a_still_point():
@@ -501,7 +501,7 @@ def test_one_receiver_pos_std_is_the_receivers():
     f_n = np.tile([0.0, 0.0, -9.80665], (n, 1)) + 7e-4 / math.sqrt(dt) * rng.standard_normal((n, 3))
     new = np.arange(n) % 100 == 99
     pos = np.array([3.0, -2.0, 0.5]) + rng.standard_normal((n, 3)) * [0.01, 0.01, 0.015]
-    out = fuse_receiver(f_n, dt, pos, new, FusionParams(antenna_sigma_h=0.01, antenna_sigma_v=0.015))
+    out = fuse_receiver(f_n, dt, pos, new, GnssAccFusionParams(antenna_sigma_h=0.01, antenna_sigma_v=0.015))
     s = slice(n // 6, None)
     z = (out["pos"][s] - [3.0, -2.0, 0.5]) / out["pos_std"][s]
     rms_z = np.sqrt(np.mean(z**2, axis=0))
@@ -510,7 +510,7 @@ def test_one_receiver_pos_std_is_the_receivers():
 
 def test_orphan_steps_are_those_no_later_fix_reaches():
     """A step is orphan when the filter restarts (or the record ends) before another fix."""
-    from marinefmu.estimators.fusion_runs import orphan_steps
+    from marinefmu.estimators.gnss_fusion.runs import orphan_steps
 
     priors = [None, 1, 1, 1, 1, None, 1]
     assert orphan_steps(priors, np.array([1, 0, 1, 0, 0, 1, 0], bool)).tolist() == [False, False, True, True, True,

@@ -9,17 +9,18 @@ import pytest
 from filterpy.kalman import KalmanFilter, rts_smoother
 
 from marinefmu.errors import ParameterError
-from marinefmu.examples import paper003
-from marinefmu.estimators.fixed_lag import FixedLagOutputs
-from marinefmu.estimators.heave import (
-    HeaveObserver, HeaveObserverParams, point_heave, vertical_acceleration,
+from marinefmu.papers import paper003
+from marinefmu.estimators.heave.fixed_lag import FixedLagOutputs
+from marinefmu.estimators.heave.bank import OscillatorBankHeave
+from marinefmu.estimators.heave.common import (
+    HeaveObserverParams, point_heave, vertical_acceleration,
 )
-from marinefmu.estimators.highpass_heave import heave_estimator
-from marinefmu.estimators.band_bank import (band_elements, band_grid, build_band_bank, discretise, resonator,
+from marinefmu.estimators.heave.observer import build_heave_model
+from marinefmu.estimators.heave.band_bank import (band_elements, band_grid, build_band_bank, discretise, resonator,
                                             smooth_densities)
-from marinefmu.estimators.oscillator_bank import build_bank, carry_map, mode_noise_covariance, mode_transition
+from marinefmu.estimators.heave.oscillator_bank import build_bank, carry_map, mode_noise_covariance, mode_transition
 from marinefmu.frames import G, body_to_euler_rates
-from marinefmu.estimators.wave_peaks import Spectrum
+from marinefmu.estimators.heave.spectrum import Spectrum
 from marinefmu.sea.motion_model import stack
 from marinefmu.sea.waves import SeaState, realise
 
@@ -27,7 +28,7 @@ DT, IMU, ARM = paper003.DT, paper003.IMU, paper003.ARM
 
 
 def _run(params, acc, roll, pitch, dt=DT):
-    obs = heave_estimator(params)
+    obs = build_heave_model(params)
     out = np.array([[r.heave, r.point_heave, r.delayed_heave, r.valid, r.modes, r.offset]
                     for r in (obs.step(acc[k], roll[k], pitch[k], dt) for k in range(len(acc)))])
     return out, obs
@@ -178,7 +179,7 @@ def test_band_min_is_the_lowest_band_element():
     acc = -(amp * w**2 * np.cos(np.outer(t, w))).sum(axis=1) - G
     lowest = {}
     for band_min in (0.25, 0.35):
-        obs = HeaveObserver(HeaveObserverParams(model="band", window=60.0, band_min=band_min))
+        obs = OscillatorBankHeave(HeaveObserverParams(model="band", window=60.0, band_min=band_min))
         for a in acc:
             obs.step(float(a), 0.0, 0.0, dt)
         lowest[band_min] = float(obs.model.omega.min())
@@ -251,7 +252,7 @@ def test_spectrum_window_grows_with_the_data_up_to_window_max():
     f_z = -G - 0.5 * np.sin(0.7 * t)
     lengths = {}
     for window_max in (60.0, 200.0):
-        obs = HeaveObserver(HeaveObserverParams(model="band", window=60.0, window_max=window_max))
+        obs = OscillatorBankHeave(HeaveObserverParams(model="band", window=60.0, window_max=window_max))
         seen = []
         for k, f in enumerate(f_z, start=1):
             obs.step(f, 0.0, 0.0, dt)
@@ -338,8 +339,8 @@ def test_heave_response_is_what_the_observer_does_to_a_sinusoid(model, measureme
         m = build_bank(np.array([0.5, 0.8]), dt, 1e-2, 3e-4, 7e-4, "exact", measurement)
     worst = 0.0
     for w in (0.35, 0.55, 0.9):
-        obs = HeaveObserver(HeaveObserverParams(model=model, measurement=measurement, smoother_lag=0.0))
-        obs._start(dt)
+        obs = OscillatorBankHeave(HeaveObserverParams(model=model, measurement=measurement, smoother_lag=0.0))
+        obs.start(dt)
         obs._use(m)
         obs.xp, obs.x = np.zeros(m.n), np.zeros(m.n)
         t = np.arange(20000) * dt
@@ -423,7 +424,7 @@ def test_bias_step_is_absorbed_by_the_offset(record, model):
 @pytest.mark.parametrize("frame", ["ned", "body"])
 def test_a_bias_step_in_mid_run_is_found_and_taken_out_by_the_wiener_filter(record, frame, caplog):
     """+0.5 m/s² from t = 300 s, along the vertical or along body z: the Wiener filter finds the
-    step 5 s later (:mod:`marinefmu.estimators.bias_step`), takes it out of its window and of
+    step 5 s later (:mod:`marinefmu.estimators.heave.bias_step`), takes it out of its window and of
     its filter's input, refines its size as it ages, and its heave is then the heave of the
     run without the step: measured 1.8 mm at most from 15 s after the step, 0.12 mm from 60 s;
     the offset output has the step. The run without a step finds none. (Before: the step stayed in
@@ -476,7 +477,7 @@ def test_two_spectral_peaks_are_tracked(model, corr):
 
 
 def test_bad_samples_coast_and_are_reported():
-    obs = HeaveObserver(HeaveObserverParams(model="band", window=60.0, omega_min=0.3))
+    obs = OscillatorBankHeave(HeaveObserverParams(model="band", window=60.0, omega_min=0.3))
     t = np.arange(1, 2001) * 0.1
     for k, tk in enumerate(t):
         acc = -0.3 * math.cos(0.8 * tk) - G
@@ -514,7 +515,7 @@ def test_highpass_baseline_has_the_analytic_response_and_refuses_a_bad_cutoff():
     are those of s²/B₄(s) (the bilinear transform warps ω by (ωΔt)²/12 = 8e-5 at ωΔt = 0.03)."""
     from scipy import signal
 
-    from marinefmu.estimators.integration import highpass_double_integration
+    from marinefmu.estimators.numerics import highpass_double_integration
     dt, w, wc = 0.05, 0.6, 0.1
     t = np.arange(0, 3000, dt)
     h = highpass_double_integration(-w**2 * np.cos(w * t), dt, wc)
@@ -535,7 +536,7 @@ def test_track_spectrum_builds_the_same_models_as_step():
     dt, p = 0.05, HeaveObserverParams(model="band", window=60.0, peak_interval=15.0, smoother_lag=0.0)
     t = dt * np.arange(1, int(200 / dt) + 1)
     f_z = -G - 0.5 * np.sin(0.7 * t) - 0.3 * np.sin(1.3 * t + 1.0)
-    full, lean = HeaveObserver(p), HeaveObserver(p)
+    full, lean = OscillatorBankHeave(p), OscillatorBankHeave(p)
     with pytest.raises(RuntimeError, match="call step until model is set"):
         lean.track_spectrum(f_z[0], 0.0, 0.0)
     models = []

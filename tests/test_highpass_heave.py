@@ -1,4 +1,4 @@
-"""The classical heave estimator sample by sample (HeaveObserver model = "highpass", the
+"""The classical heave estimator sample by sample (OscillatorBankHeave model = "highpass", the
 baseline of issue 9): the same filter as the offline function, its stated response, its
 handling of bad samples and its parameters."""
 import json
@@ -9,9 +9,11 @@ import pytest
 from scipy import signal
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.heave import HeaveObserver, HeaveObserverParams
-from marinefmu.estimators.highpass_heave import HighpassHeave, heave_estimator
-from marinefmu.estimators.integration import highpass_double_integration, highpass_sections
+from marinefmu.estimators.heave.bank import OscillatorBankHeave
+from marinefmu.estimators.heave.common import HeaveObserverParams
+from marinefmu.estimators.heave.highpass import HighpassHeave
+from marinefmu.estimators.heave.observer import build_heave_model
+from marinefmu.estimators.numerics import highpass_double_integration, highpass_sections
 
 DT = 0.01
 G = 9.80665
@@ -82,10 +84,10 @@ def test_a_bad_sample_is_held_flagged_and_the_state_round_trips(caplog):
 
 
 def test_the_model_switch_and_its_parameters():
-    assert isinstance(heave_estimator(HeaveObserverParams(model="highpass")), HighpassHeave)
-    assert isinstance(heave_estimator(HeaveObserverParams(model="band")), HeaveObserver)
+    assert isinstance(build_heave_model(HeaveObserverParams(model="highpass")), HighpassHeave)
+    assert isinstance(build_heave_model(HeaveObserverParams(model="band")), OscillatorBankHeave)
     with pytest.raises(ParameterError, match="model = .highpass. is not an observer model"):
-        HeaveObserver(HeaveObserverParams(model="highpass"))
+        OscillatorBankHeave(HeaveObserverParams(model="highpass"))
     with pytest.raises(ParameterError, match=r"highpass_cutoff = 6\.0 is out of range"):
         HeaveObserverParams(model="highpass", highpass_cutoff=6.0)
     with pytest.raises(ParameterError, match="highpass_order = 9 is out of range"):

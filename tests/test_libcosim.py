@@ -3,7 +3,7 @@ in its own subprocess (marker ``isolated``): a native crash fails that test, not
 import numpy as np
 import pytest
 
-from marinefmu.sea.motion_model import REAL_OUTPUTS, VesselMotionModel, VesselMotionParams
+from marinefmu.sea.motion_model import REAL_OUTPUTS, VesselMotion, VesselMotionParams
 
 pytestmark = [pytest.mark.fmu, pytest.mark.libcosim, pytest.mark.isolated]
 libcosim = pytest.importorskip("libcosimpy")
@@ -32,7 +32,7 @@ def test_vessel_motion_runs_in_libcosim_and_matches_in_process(fmu_dir):
     assert ex.simulate_until(steps * dt_ns)
     got = np.array(obs.last_real_values(idx, [vr[v.name] for v in REAL_OUTPUTS]))
 
-    m = VesselMotionModel(VesselMotionParams.from_flat({**params, "sea.components": 120, "vessel.preset": "semisub"}))
+    m = VesselMotion(VesselMotionParams.from_flat({**params, "sea.components": 120, "vessel.preset": "semisub"}))
     for k in range(steps):
         ref = m.step(k * 0.01 + 0.01, 0.01)
     # libcosim keeps time in integer nanoseconds; the converted doubles differ from k·0.01 by ~1 ulp
@@ -50,7 +50,7 @@ def test_centre_of_rotation_fed_by_vessel_motion_in_libcosim(fmu_dir):
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
-    from marinefmu.estimators.centre_of_rotation import CentreOfRotation, CentreOfRotationParams
+    from marinefmu.estimators.centre_of_rotation.filter import CentreOfRotation, CentreOfRotationParams
     from marinefmu.sea.motion_model import REAL_INDEX
 
     log_output_level(CosimLogLevel.ERROR)
@@ -74,7 +74,7 @@ def test_centre_of_rotation_fed_by_vessel_motion_in_libcosim(fmu_dir):
     outs = ["offset.x", "offset.y", "offset.z", "acc_cr.z"]
     got = np.array(obs.last_real_values(c, [cvr[n] for n in outs]))
 
-    m = VesselMotionModel(VesselMotionParams.from_flat({**params, "vessel.preset": "research36"}))
+    m = VesselMotion(VesselMotionParams.from_flat({**params, "vessel.preset": "research36"}))
     est = CentreOfRotation(CentreOfRotationParams())
     y = m.peek(0.0)
     for k in range(steps):
@@ -94,8 +94,8 @@ def test_heave_observer_fed_by_vessel_motion_in_libcosim(fmu_dir):
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
-    from marinefmu.estimators.heave import HeaveObserverParams
-    from marinefmu.estimators.highpass_heave import heave_estimator
+    from marinefmu.estimators.heave.common import HeaveObserverParams
+    from marinefmu.estimators.heave.observer import build_heave_model
     from marinefmu.sea.motion_model import REAL_INDEX
 
     log_output_level(CosimLogLevel.ERROR)
@@ -122,8 +122,8 @@ def test_heave_observer_fed_by_vessel_motion_in_libcosim(fmu_dir):
     got = np.array(obs.last_real_values(h, [hvr[n] for n in outs]))
     valid = obs.last_boolean_values(h, [hvr["valid"]])[0]
 
-    m = VesselMotionModel(VesselMotionParams.from_flat(vparams))
-    est = heave_estimator(HeaveObserverParams(window=60.0, point=(40.0, 0.0, 0.0)))     # the default model
+    m = VesselMotion(VesselMotionParams.from_flat(vparams))
+    est = build_heave_model(HeaveObserverParams(window=60.0, point=(40.0, 0.0, 0.0)))     # the default model
     y = m.peek(0.0)
     for k in range(steps):
         r = est.step([y[REAL_INDEX[f"imu.acc.{a}"]] for a in "xyz"], y[REAL_INDEX["truth.roll"]],

@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 
 from marinefmu.errors import ParameterError, RaoFileError
 from marinefmu.frames import GRAVITY_N
-from marinefmu.sea.motion_model import REAL_INDEX, VesselMotionModel, VesselMotionParams
+from marinefmu.sea.motion_model import REAL_INDEX, VesselMotion, VesselMotionParams
 from marinefmu.sea.sensors import GnssParams, ImuParams
 
 QUIET = {"imu.acc_noise": 0.0, "imu.gyro_noise": 0.0, "imu.acc_bias_instability": 0.0,
@@ -16,7 +16,7 @@ ARM = {"imu.x": 12.0, "imu.y": -3.0, "imu.z": -6.0}
 
 
 def model(**flat):
-    return VesselMotionModel(VesselMotionParams.from_flat(flat))
+    return VesselMotion(VesselMotionParams.from_flat(flat))
 
 
 def out(y, name):

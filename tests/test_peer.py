@@ -3,7 +3,7 @@
 quantity). The calm / moderate / rough comparison is in ``make bench`` (part ``peer``)."""
 import pytest
 
-from marinefmu.peer import compare_attitude, system_sea
+from marinefmu.bench.peer_smsfusion import compare_attitude, system_sea
 
 pytest.importorskip("smsfusion")
 
@@ -29,7 +29,7 @@ def test_gnss_aided_cog_against_smsfusion_aided_ins():
     grids; over the 10-minute calm / moderate / rough seas of ``make bench`` ours is
     0.29 / 0.27 / 0.30 cm in each against the peer's 0.46-0.58 / 0.97-1.00 / 0.33-0.66 cm; with
     the paper's single q = 0.005 down was 0.44 cm, worse than the peer in calm and moderate seas.)"""
-    from marinefmu.peer import compare_gnss_aided
+    from marinefmu.bench.peer_smsfusion import compare_gnss_aided
 
     rec, imu, fusion = system_sea(3.0, 9.0, 300.0)
     r = compare_gnss_aided(rec, 0.01, imu, fusion)

@@ -7,7 +7,7 @@ The record is fixed and the runs are deterministic; absolute bounds are the meas
 import numpy as np
 import pytest
 
-from marinefmu import peer_orcaflex as po
+from marinefmu.bench import peer_orcaflex as po
 
 pytest.importorskip("smsfusion")
 

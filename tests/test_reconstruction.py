@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.reconstruction import (_complex_least_squares, _least_squares_amplitudes, decompose,
+from marinefmu.estimators.reconstruction.decomposition import (_complex_least_squares, _least_squares_amplitudes, decompose,
                                                  exp_grid, reconstruct_displacement, tilt_correct)
-from marinefmu.estimators.sliding_reconstruction import SlidingParams, SlidingReconstructor
-from marinefmu.examples import paper000_sdof, paper000_semisub
+from marinefmu.estimators.reconstruction.sliding import DisplacementReconstructorParams, DisplacementReconstructor
+from marinefmu.papers import paper000_sdof, paper000_semisub
 
 LAM = -0.05 + 2j * math.pi * 0.2
 GAM = 0.75 * np.exp(0.3j)
@@ -141,7 +141,7 @@ def sliding_record(seconds=330.0):
 
 def test_sliding_window_centred_estimate_and_validity():
     acc, euler, cog = sliding_record()
-    sr = SlidingReconstructor(SlidingParams(window=200.0, hop=20.0, lever_arm=paper000_semisub.LEVER_ARM))
+    sr = DisplacementReconstructor(DisplacementReconstructorParams(window=200.0, hop=20.0, lever_arm=paper000_semisub.LEVER_ARM))
     out = [sr.step(acc[k], euler[k], 0.01) for k in range(len(acc))]
     first = next(k for k, r in enumerate(out) if r.valid)
     assert first == 19999  # the sample at t = 200 s fills the window
@@ -156,15 +156,15 @@ def test_sliding_window_centred_estimate_and_validity():
 
 def test_sliding_bad_samples_hold_invalidate_and_state_round_trips():
     acc, euler, _ = sliding_record(95.0)
-    p = SlidingParams(window=70.0, hop=10.0, cutoff=0.04)
-    sr = SlidingReconstructor(p, dt=0.01)
+    p = DisplacementReconstructorParams(window=70.0, hop=10.0, cutoff=0.04)
+    sr = DisplacementReconstructor(p, dt=0.01)
     for k in range(7500):
         sr.step(acc[k], euler[k], 0.01)
     r = sr.step([np.nan, 0.0, 0.0], euler[7500], 0.01)
     assert not r.valid and r.warning and all(map(math.isfinite, r.disp + r.centred_disp))
     saved = json.loads(json.dumps(sr.get_state()))
     a = [sr.step(acc[k], euler[k], 0.01) for k in range(7501, 9100)]
-    sr2 = SlidingReconstructor(p)
+    sr2 = DisplacementReconstructor(p)
     sr2.set_state(saved)
     b = [sr2.step(acc[k], euler[k], 0.01) for k in range(7501, 9100)]
     assert [x.disp for x in a] == [x.disp for x in b]
@@ -178,4 +178,4 @@ def test_sliding_bad_samples_hold_invalidate_and_state_round_trips():
 ])
 def test_sliding_parameters_refused_by_name(kwargs, match):
     with pytest.raises(ParameterError, match=match):
-        SlidingParams(**kwargs).validate(0.01)
+        DisplacementReconstructorParams(**kwargs).validate(0.01)

@@ -2,7 +2,7 @@
 import pytest
 
 from marinefmu.errors import ScenarioError
-from marinefmu.scenarios import builtin_scenarios, load_scenario, parse_scenario
+from marinefmu.cosim.scenarios import builtin_scenarios, load_scenario, parse_scenario
 
 GOOD = """
 [scenario]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from marinefmu.cosim.ssp import Component, Connection, SystemDescription
-from marinefmu.scoring import score
+from marinefmu.analysis.scoring import score
 
 
 def _result(n=2001, dt=0.1):

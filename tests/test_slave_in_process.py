@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
-from marinefmu.sea.motion_model import REAL_OUTPUTS, VesselMotionModel, VesselMotionParams
+from marinefmu.sea.motion_model import REAL_OUTPUTS, VesselMotion, VesselMotionParams
 
 SCRIPT = Path(__file__).resolve().parents[1] / "models" / "VesselMotion.py"
 
@@ -27,7 +27,7 @@ def test_slave_steps_like_the_model_and_exposes_every_variable():
     for k in range(50):
         assert s.do_step(k * 0.01, 0.01) is True
         got.append(s.get_real([names[v.name] for v in REAL_OUTPUTS]))
-    m = VesselMotionModel(VesselMotionParams.from_flat({"sea.hs": 4.0, "vessel.preset": "semisub"}))
+    m = VesselMotion(VesselMotionParams.from_flat({"sea.hs": 4.0, "vessel.preset": "semisub"}))
     np.testing.assert_array_equal(got, [m.step(k * 0.01 + 0.01, 0.01) for k in range(50)])
 
 

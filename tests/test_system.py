@@ -5,7 +5,7 @@ import pytest
 from marinefmu.cosim.ssp import Component, Connection, SystemDescription, read_ssd, write_ssd
 from marinefmu.cosim.system import SystemRunner, load_csv, save_csv
 from marinefmu.errors import ParameterError, SystemError_
-from marinefmu.sea.motion_model import VesselMotionModel, VesselMotionParams
+from marinefmu.sea.motion_model import VesselMotion, VesselMotionParams
 
 pytestmark = pytest.mark.fmu
 
@@ -52,7 +52,7 @@ def test_runner_wires_outputs_to_inputs_with_rates(fmu_dir, relay_fmu, tmp_path)
     np.testing.assert_allclose(r["slow.time"][k % 5 == 0][1:], r["time"][k % 5 == 0][1:], atol=1e-12)
     np.testing.assert_allclose(r["slow.y"][5::5], r["vessel.truth.cog.d"][0:-5:5], atol=1e-15)
     # the vessel through the runner equals the in-process model
-    m = VesselMotionModel(VesselMotionParams.from_flat({"sea.hs": 3.0}))
+    m = VesselMotion(VesselMotionParams.from_flat({"sea.hs": 3.0}))
     ref = [m.step(k * 0.01 + 0.01, 0.01) for k in range(200)]
     from marinefmu.sea.motion_model import REAL_INDEX
 
@@ -135,7 +135,7 @@ def test_bad_wiring_is_refused_before_any_fmu_is_instantiated(fmu_dir, relay_fmu
     monkeypatch.setattr(FMU2Slave, "instantiate", no_instantiate)
     with pytest.raises(SystemError_, match=match):
         SystemRunner(sysd, tmp_path)
-    from marinefmu.cosim.libcosim_runner import write_osp_system
+    from marinefmu.cosim.libcosim import write_osp_system
     from marinefmu.cosim.ssp import write_ssp
 
     with pytest.raises(SystemError_, match=match):
@@ -184,7 +184,7 @@ def test_build_skips_unchanged_models_and_rebuilds_a_changed_one(tmp_path):
     import shutil
     from pathlib import Path
 
-    from marinefmu.cosim.build import build_all
+    from marinefmu.fmu.build import build_all
 
     models = tmp_path / "models"
     models.mkdir()
@@ -203,7 +203,7 @@ def _quick_system():
     to 26 and 30 s, so every estimator works within 40 s."""
     from dataclasses import replace
 
-    from marinefmu.scenarios import load_scenario
+    from marinefmu.cosim.scenarios import load_scenario
 
     sysd = load_scenario("system").system
     short = {"heave": {"window": 26.0, "peak_interval": 5.0, "omega_min": 0.5}, "recon": {"window": 30.0, "hop": 5.0, "cutoff": 0.1}}
@@ -255,7 +255,7 @@ def test_two_builders_of_one_folder_take_turns(tmp_path):
     models.mkdir()
     shutil.copy(Path(__file__).parent / "models" / "MfTestRelay.py", models)
     dest = tmp_path / "fmus"
-    code = ("import sys\nfrom pathlib import Path\nfrom marinefmu.cosim.build import build_all\n"
+    code = ("import sys\nfrom pathlib import Path\nfrom marinefmu.fmu.build import build_all\n"
             f"print([r.rebuilt for r in build_all(Path({str(models)!r}), Path({str(dest)!r}), verbose=False)])\n")
     procs = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for _ in range(2)]
@@ -271,7 +271,7 @@ def test_runs_leave_sys_path_as_they_found_it(fmu_dir):
     import sys
 
     from marinefmu.cosim.system import SystemRunner
-    from marinefmu.scenarios import load_scenario
+    from marinefmu.cosim.scenarios import load_scenario
 
     sc = load_scenario("system")
     SystemRunner(sc.system, fmu_dir).run(0.05, record=sc.record, progress=False)   # first-run imports

@@ -7,10 +7,10 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.attitude import AttitudeParams, estimate_attitude
-from marinefmu.estimators.tilt_refinement import refine_tilt, tilt_rms_bound_deg
+from marinefmu.estimators.attitude.estimator import AttitudeEstimatorParams, estimate_attitude
+from marinefmu.estimators.attitude.tilt_refinement import refine_tilt, tilt_rms_bound_deg
 from marinefmu.frames import G
-from marinefmu.sea.motion_model import REAL_INDEX, VesselMotionModel, VesselMotionParams
+from marinefmu.sea.motion_model import REAL_INDEX, VesselMotion, VesselMotionParams
 
 DT = 0.1
 
@@ -63,12 +63,12 @@ def test_gyro_noise_floor_matches_its_closed_form_on_vessel_motion():
     wave-band leakage (0.002-0.003 deg noise-free)."""
     values = {"vessel.preset": "semisub", "sea.hs": 10.0, "sea.tp": 12.0, "sea.heading": 2.6, "sea.seed": 1,
               "imu.x": 41.0, "imu.y": 35.0, "imu.z": -35.0, "imu.acc_noise": 0.0, "imu.acc_bias_instability": 0.0}
-    m = VesselMotionModel(VesselMotionParams.from_flat(values))
+    m = VesselMotion(VesselMotionParams.from_flat(values))
     y = np.array([m.step((k + 1) * 0.01, 0.01) for k in range(90000)])
     get = lambda names: y[:, [REAL_INDEX[n] for n in names]]  # noqa: E731
     gyro, acc = get([f"imu.gyro.{a}" for a in "xyz"]), get([f"imu.acc.{a}" for a in "xyz"])
     truth = get(["truth.roll", "truth.pitch"])
-    p = AttitudeParams(init_euler=(0.0, 0.0, float(y[0, REAL_INDEX["truth.yaw"]])))
+    p = AttitudeEstimatorParams(init_euler=(0.0, 0.0, float(y[0, REAL_INDEX["truth.yaw"]])))
     att = estimate_attitude(gyro, acc, 0.01, p)
     refined = Rotation.from_quat(refine_tilt(att["q"], acc, 0.01, 0.02), scalar_first=True).as_euler("ZYX")[:, :0:-1]
     keep = slice(20000, 80000)

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from conftest import LibcosimBeside
 
-from marinefmu.cosim.libcosim_runner import write_osp_system
+from marinefmu.cosim.libcosim import write_osp_system
 from marinefmu.cosim.ssp import read_ssp, write_ssp
 from marinefmu.cosim.system import SystemRunner
-from marinefmu.scenarios import load_scenario
-from marinefmu.scoring import score
+from marinefmu.cosim.scenarios import load_scenario
+from marinefmu.analysis.scoring import score
 
 pytestmark = [pytest.mark.fmu, pytest.mark.libcosim]
 

@@ -1,4 +1,4 @@
-"""The causal Wiener heave estimator (HeaveObserver model = "wiener", beyond paper 003): its
+"""The causal Wiener heave estimator (OscillatorBankHeave model = "wiener", beyond paper 003): its
 design against closed forms, the noise subtraction, a bias step, bad samples, state restore and
 the model switch. Accuracy against VesselMotion truth is in test_heave.py."""
 import math
@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.heave import HeaveObserver, HeaveObserverParams
-from marinefmu.estimators.highpass_heave import heave_estimator
-from marinefmu.estimators.wave_peaks import Spectrum
-from marinefmu.estimators.wiener_heave import WienerHeave, sea_heave_density, wiener_taps
+from marinefmu.estimators.heave.bank import OscillatorBankHeave
+from marinefmu.estimators.heave.common import HeaveObserverParams
+from marinefmu.estimators.heave.observer import build_heave_model
+from marinefmu.estimators.heave.spectrum import Spectrum
+from marinefmu.estimators.heave.wiener import WienerHeave, sea_heave_density, wiener_taps
 from marinefmu.frames import G
 
 DT, N, Q = 0.05, 7e-4, 1e-4
@@ -128,21 +129,21 @@ def test_state_restore_repeats_the_run():
 
 
 def test_model_switch():
-    assert isinstance(heave_estimator(HeaveObserverParams(model="wiener")), WienerHeave)
+    assert isinstance(build_heave_model(HeaveObserverParams(model="wiener")), WienerHeave)
     assert HeaveObserverParams().model == "wiener"                # the default
-    assert HeaveObserver().params.model == "band"                # the observer class's own default
+    assert OscillatorBankHeave().params.model == "band"                # the observer class's own default
     with pytest.raises(ParameterError, match="model = 'wiener' is not an observer model"):
-        HeaveObserver(HeaveObserverParams(model="wiener"))
+        OscillatorBankHeave(HeaveObserverParams(model="wiener"))
     with pytest.raises(ParameterError, match="model = 'kalman' is not allowed"):
         HeaveObserverParams(model="kalman")
 
 
 def test_bias_step_search_is_the_least_squares_hinge_fit():
-    """The closed-form search (:mod:`marinefmu.estimators.bias_step`) against the hinge fit done
+    """The closed-form search (:mod:`marinefmu.estimators.heave.bias_step`) against the hinge fit done
     by numpy's least squares, candidate by candidate: the same size at every candidate (1e-9),
     the same best candidate, found where the step is; no step in the same data without it; a
     step younger than 5 s is not yet reported (a fit limited to older kinks would misplace it)."""
-    from marinefmu.estimators.bias_step import MIN_AGE, find_bias_step
+    from marinefmu.estimators.heave.bias_step import MIN_AGE, find_bias_step
 
     rng = np.random.default_rng(4)
     dt, n = 0.05, 12000                                   # 600 s, 600 blocks of 1 s

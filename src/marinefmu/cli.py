@@ -33,25 +33,25 @@ def _fmu_dir(given: str | None) -> Path:
     """``--fmus`` if given, else the checkout's ``fmus/`` (built first where stale)."""
     if given:
         return Path(given)
-    from .cosim.build import build_all, repo_root
+    from .fmu.build import build_all, repo_root
 
     build_all(verbose=False)
     return repo_root() / "fmus"
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
-    from .cosim.build import build_all
+    from .fmu.build import build_all
 
     build_all(force=args.force)
     return 0
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from .cosim.libcosim_runner import write_osp_system
+    from .cosim.libcosim import write_osp_system
     from .cosim.ssp import read_ssp, write_ssd, write_ssp
     from .cosim.system import SystemRunner, save_csv
-    from .report import plot_vessel, vessel_components, vessel_summary
-    from .scenarios import Scenario, load_scenario
+    from .analysis.vessel_plots import plot_vessel, vessel_components, vessel_summary
+    from .cosim.scenarios import Scenario, load_scenario
 
     package = str(args.scenario).endswith(".ssp")
     if package:   # an SSP package: its own FMUs, unpacked next to the results
@@ -63,7 +63,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         scenario = load_scenario(args.scenario)
     fmu_dir = Path(args.fmus) if args.fmus else (Path(".") if package else None)
     if fmu_dir is None:
-        from .cosim.build import build_all, repo_root
+        from .fmu.build import build_all, repo_root
 
         build_all(verbose=False)
         fmu_dir = repo_root() / "fmus"
@@ -102,7 +102,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     vessels = [c.name for c in scenario.system.components if c.kind == "VesselMotion"] or vessel_components(result)
     scores = {}
     if vessels:
-        from .scoring import score
+        from .analysis.scoring import score
 
         scores = score(result, scenario.system, vessels[0])
         for comp, metrics in scores.items():
@@ -110,7 +110,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             for k, v in metrics.items():
                 print(f"    {k:28s} {v:.6g}")
     if scores:
-        from .system_report import write_report
+        from .analysis.html_report import write_report
 
         page = write_report(result, scenario.system, scores, vessels[0], out, f"marinefmu: scenario {scenario.name}",
                             scenario.description)
@@ -122,7 +122,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _bench_parts(text: str) -> str:
-    from .bench import PARTS
+    from .bench.parts import PARTS
 
     bad = [p for p in text.split(",") if p not in PARTS]
     if bad:
@@ -131,7 +131,7 @@ def _bench_parts(text: str) -> str:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from .bench import run_benchmarks
+    from .bench.parts import run_benchmarks
 
     run_benchmarks(Path(args.out), steps=args.steps, memory_steps=args.memory_steps, memory_cycles=args.memory_cycles,
                    parts=tuple(args.parts.split(",")))
@@ -141,8 +141,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 def _cmd_design_ahc(args: argparse.Namespace) -> int:
     import shutil
 
-    from .ahc_loop import GAINS, design_loop, find_loop, write_gains
-    from .scenarios import load_scenario
+    from .ahc.loop import GAINS, design_loop, find_loop, write_gains
+    from .cosim.scenarios import load_scenario
 
     scenario = load_scenario(args.scenario)
     out = Path(args.out)
@@ -202,7 +202,7 @@ def _cmd_design_ahc(args: argparse.Namespace) -> int:
 
 
 def _cmd_example(args: argparse.Namespace) -> int:
-    from .examples.registry import EXAMPLES, format_value
+    from .papers.registry import EXAMPLES, format_value
 
     if args.list or not args.name:
         for name, (text, _) in EXAMPLES.items():
@@ -282,7 +282,7 @@ def main(argv: list[str] | None = None) -> int:
     k = sub.add_parser("bench", help="measure speed (writes JSON and prints a table)")
     k.add_argument("--out", default="bench", help="output folder for bench.json (default bench/)")
     k.add_argument("--steps", type=int, default=60000, help="FMU steps per measurement (default 60000)")
-    from .bench import PARTS
+    from .bench.parts import PARTS
 
     k.add_argument("--parts", default=",".join(PARTS), type=_bench_parts,
                    help=f"comma-separated parts to (re)measure, merged into bench.json (default {','.join(PARTS)})")

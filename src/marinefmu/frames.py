@@ -255,7 +255,7 @@ def nav_tilt(rot: np.ndarray) -> np.ndarray:
     of the rotation vector of R_nb·R_z(ψ)ᵀ, the attitude with its yaw ψ taken off (to first
     order roll and pitch turned into NED by the heading). A small rotation of the attitude,
     R_nb → exp([ε]×)·R_nb, moves it by (ε_N, ε_E) to second order in the angles (the wave tilt
-    of :class:`~marinefmu.estimators.wave_coast.WaveCoast`).
+    of :class:`~marinefmu.estimators.gnss_fusion.wave_coast.WaveCoast`).
 
     Examples
     --------

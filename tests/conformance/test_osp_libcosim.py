@@ -16,7 +16,7 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from marinefmu.cosim import osp
+from marinefmu.fmu import osp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from fmu_worker import FMUS, PARAMS  # noqa: E402

@@ -1,8 +1,8 @@
 """Test-only FMU: y = gain · u (real) and counts its steps; used to test wiring and rates."""
 from pythonfmu import Fmi2Slave
 
-from marinefmu.cosim.slave import SlaveIO
-from marinefmu.interface import Variable, real
+from marinefmu.fmu.slave import SlaveIO
+from marinefmu.variables import Variable, real
 
 PARAMETERS = [real("gain", 2.0, "", "Gain")]
 INPUTS = [real("u", 0.0, "m", "Input signal")]

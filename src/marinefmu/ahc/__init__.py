@@ -1,1 +1,3 @@
-"""Active heave compensation (issue 9): winch and load physics, controller, design."""
+"""Active heave compensation: the winch and load physics (:mod:`.winch`), the controller
+(:mod:`.controller`), its design with python-control (:mod:`.design`) and the design loop that
+identifies, tunes and verifies it on a co-simulated system (:mod:`.loop`)."""

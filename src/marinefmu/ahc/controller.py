@@ -10,7 +10,7 @@ e.g. of a true position), so the speed command is
 
 with dĥ/dt the estimated heave rate (``point.heave_rate``) as feedforward and PI feedback on the
 measured wire length L (the winch's ``length``). ``k_ff`` = 1 is full compensation, 0 none.
-The gains come from :mod:`marinefmu.ahc_design` or by hand. A bad input (NaN, Inf, absurd)
+The gains come from :mod:`marinefmu.ahc.design` or by hand. A bad input (NaN, Inf, absurd)
 holds the last good one and sets ``valid`` false; the integrator is clamped to ±``max_integral``
 and the command is clipped to ±``max_command`` (set it to the winch's ``max_speed``), with
 conditional integration: while the command is clipped, the error that would drive it further
@@ -34,7 +34,7 @@ from ..estimators.samples import bad_scalar
 
 
 @dataclass(frozen=True)
-class ControllerParams:
+class AhcControllerParams:
     """Parameters of :class:`AhcController` (FMU names in brackets).
 
     Parameters
@@ -96,8 +96,12 @@ class ControllerOutput:
 class AhcController:
     """The controller (module docstring), one step at a time."""
 
-    def __init__(self, params: ControllerParams | None = None) -> None:
-        self.params = params or ControllerParams()
+    def __init__(self, params: AhcControllerParams | None = None) -> None:
+        self.params = params or AhcControllerParams()
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the initial state: no integral, disengaged, inputs at rest at ``length0``."""
         self.integral = 0.0
         self.engagement = 0.0
         self.inputs = (0.0, 0.0, self.params.length0)   # last good heave, heave rate, length

@@ -52,8 +52,8 @@ ACC_MARGIN = 0.9
 
 
 @dataclass(frozen=True)
-class WinchParams:
-    """Parameters of :class:`WinchLoadModel` (FMU names in brackets).
+class AhcWinchParams:
+    """Parameters of :class:`AhcWinch` (FMU names in brackets).
 
     Parameters
     ----------
@@ -137,19 +137,19 @@ class WinchState:
     load_e: float = 0.0    # load position, east [m]
 
 
-class WinchLoadModel:
+class AhcWinch:
     """The winch, wire and load (module docstring), one co-simulation step at a time.
 
     Parameters
     ----------
-    params : WinchParams
+    params : AhcWinchParams
         Validated parameters.
     tip : float
         Crane-tip position at the start, down [m]: the load starts at rest below it.
     """
 
-    def __init__(self, params: WinchParams | None = None, tip: float = 0.0) -> None:
-        self.params = params or WinchParams()
+    def __init__(self, params: AhcWinchParams | None = None, tip: float = 0.0) -> None:
+        self.params = params or AhcWinchParams()
         self.reset(tip)
 
     def reset(self, tip: float = 0.0) -> None:

@@ -18,8 +18,8 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-from ..report import _pyplot
-from ..scoring import COMMON_METRICS
+from ..analysis.vessel_plots import pyplot
+from ..analysis.scoring import COMMON_METRICS
 from .spec import CampaignSpec
 
 #: Cells and bars drawn per figure row.
@@ -55,7 +55,7 @@ def plot_campaign(spec: CampaignSpec, rows: list[dict[str, Any]], out: str | Pat
     their paths."""
     import numpy as np
 
-    plt = _pyplot()
+    plt = pyplot()
     out = Path(out)
     ok = [r for r in rows if r["status"] == "ok"]
     # the metrics are the table's component.metric columns (the grid keys have dots too)

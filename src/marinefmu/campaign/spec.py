@@ -45,7 +45,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParameterError, ScenarioError, SystemError_
-from ..scenarios import Scenario, flatten, load_scenario
+from ..cosim.scenarios import Scenario, flatten, load_scenario
 
 _TOP = {"campaign", "grid", "sets"}
 _CAMPAIGN = {"name", "scenario", "duration", "settle", "timeout", "engine", "vessel", "metrics", "keep_series"}
@@ -248,7 +248,7 @@ def parse_spec(text: str, fmu_dir: str | Path, source: str = "<string>", base: P
         raise _fail(source, f"campaign.keep_series = {keep!r} must be true or false")
 
     from ..cosim.system_check import check_system, lookup, value_fits
-    from ..scoring import COMMON_METRICS, METRICS
+    from ..analysis.scoring import COMMON_METRICS, METRICS
 
     system = scenario.system
     try:

@@ -4,7 +4,7 @@ The FMUs travel with the campaign (scattered once to every worker as bytes), so 
 marinefmu and its dependencies installed but no shared file system: each worker process writes
 them once to a temporary folder of its own and extracts them there (:func:`fmu_folder`). A run
 instantiates the scenario's FMUs in the worker process (:class:`~marinefmu.cosim.system.SystemRunner`),
-simulates, scores the estimators against the vessel's truth (:func:`marinefmu.scoring.score`)
+simulates, scores the estimators against the vessel's truth (:func:`marinefmu.analysis.scoring.score`)
 and returns a small record; the time series only when the campaign keeps them. Any error of a
 run (an FMU refusing a combination of values, a failed step, the wall-time limit) becomes a
 record with ``status = "failed"`` and the error, so the campaign goes on.
@@ -89,10 +89,10 @@ def prepare(local: bool = False) -> int:
 
     if local and threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-    import marinefmu.cosim.estimator_io  # noqa: F401
+    import marinefmu.fmu.tables  # noqa: F401
     import marinefmu.cosim.system  # noqa: F401
-    import marinefmu.estimators.heave  # noqa: F401
-    import marinefmu.scoring  # noqa: F401
+    import marinefmu.estimators.heave.observer  # noqa: F401
+    import marinefmu.analysis.scoring  # noqa: F401
 
     return os.getpid()
 
@@ -110,9 +110,9 @@ def run_one(run: Run, task: Job, fmus: dict[str, bytes]) -> dict[str, Any]:
         ``worker`` (host:pid), ``rss_mb`` (the worker's resident memory after the run), and
         ``series`` (structured array) when the task keeps it.
     """
-    from ..bench_system import rss_mb
+    from ..bench.system import rss_mb
     from ..cosim.system import SystemRunner
-    from ..scoring import score
+    from ..analysis.scoring import score
 
     start = time.perf_counter()
     out: dict[str, Any] = {"id": run.id, "values": run.values, "status": "ok", "error": "",

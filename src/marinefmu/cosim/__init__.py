@@ -1,1 +1,3 @@
-"""The FMI side: slave plumbing, FMU build and units, system files and the FMPy runner."""
+"""Running systems of FMUs: SSP system files (:mod:`.ssp`), scenario files (:mod:`.scenarios`),
+the static system check (:mod:`.system_check`), the FMPy master and its data exchange
+(:mod:`.system`, :mod:`.exchange`) and the same system under OSP libcosim (:mod:`.libcosim`)."""

@@ -362,7 +362,7 @@ class SystemRunner:
                 except Exception as exc:  # FMPy raises FMICallException
                     raise self._fail(name, "initialisation", t0, exc) from None
                 # marinefmu slaves refuse a parameter by logging an error (they never raise:
-                # see marinefmu.cosim.slave), so an error logged here is a refusal
+                # see marinefmu.fmu.slave), so an error logged here is a refusal
                 refused = [m for m in self.messages[logged:] if m.instance == name and m.status in ("ERROR", "FATAL")]
                 if refused:
                     raise self._fail(name, "initialisation", t0, RuntimeError(refused[0].text))

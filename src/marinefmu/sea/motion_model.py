@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import ParameterError, check_choice, check_int, check_vector
 from ..frames import attitude_kinematics, rigid_point_operator, specific_force
-from ..interface import Variable, real, resolve, vec
+from ..variables import Variable, real, resolve, vec
 from .sensors import ANTENNAS, Gnss, GnssParams, Imu, ImuParams
 from .vessel import PRESETS, MotionSeries, RaoTable, check_speed, load_rao_csv, preset_raos
 from .waves import SPECTRA, SeaState, realise
@@ -109,7 +109,7 @@ BOOLEAN_OUTPUTS: list[Variable] = [
     Variable("gnss.new", "boolean", False, "", "True on the step in which a new GNSS fix arrived"),
     Variable("truth.cr.defined", "boolean", False, "", "True when the motion mode defines a rotation centre (vessel.mode = 1)"),
 ]
-#: Index of each real output in the vector returned by :meth:`VesselMotionModel.step`.
+#: Index of each real output in the vector returned by :meth:`VesselMotion.step`.
 REAL_INDEX = {v.name: i for i, v in enumerate(REAL_OUTPUTS)}
 
 
@@ -217,7 +217,7 @@ class RigidBodyState:
         return n
 
 
-class VesselMotionModel:
+class VesselMotion:
     """The in-process VesselMotion model: call :meth:`step` with the end time of each step.
 
     Parameters
@@ -227,7 +227,7 @@ class VesselMotionModel:
 
     Examples
     --------
-    >>> m = VesselMotionModel(VesselMotionParams())
+    >>> m = VesselMotion(VesselMotionParams())
     >>> y = m.step(0.01, 0.01)          # outputs at t = 0.01 s, ordered as REAL_OUTPUTS
     >>> y[REAL_INDEX["truth.cog.d"]]    # heave of the COG [m, down]  # doctest: +SKIP
     """
@@ -330,7 +330,7 @@ def simulate_record(params: VesselMotionParams, duration: float, dt: float = 0.0
         (N,) arrays keyed by the FMU output names of :data:`REAL_OUTPUTS` and
         :data:`BOOLEAN_OUTPUTS` (``"imu.acc.x"``, ``"truth.roll"``, ``"gnss.valid"``, …).
     """
-    model = VesselMotionModel(params)
+    model = VesselMotion(params)
     n = int(round(duration / dt))
     y = np.empty((n, len(REAL_OUTPUTS)))
     flags = np.empty((n, len(BOOLEAN_OUTPUTS)), dtype=bool)

@@ -1,0 +1,279 @@
+"""A one-page, self-contained HTML report of a whole-system run (issue 7, the main job).
+
+:func:`write_report` takes a :class:`~.cosim.system.SystemRunner` result, the scenario and the
+scores of :func:`~.scoring.score`, and writes ``report.html`` with the figures embedded (PNG,
+base64): the system's diagram, truth against estimate for every estimator over the last minute,
+error traces over the run, the heave spectra, the centre-of-rotation convergence, and a table of
+each estimator's accuracy against its goal from the issue tracker. It is written for a reader
+who has not read the code: every figure and row says what it shows and in which unit.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..cosim.ssp import SystemDescription
+
+#: Goals of the issue tracker per (FMU type, metric): (text, test on the scores of that
+#: component returning True when met). Metrics without a goal are reported without one.
+GOALS = {
+    ("AttitudeEstimator", "roll_deg"): ("≤ 0.02° (issue 3)", lambda s: s["roll_deg"] <= 0.02),
+    ("AttitudeEstimator", "pitch_deg"): ("≤ 0.02° (issue 3)", lambda s: s["pitch_deg"] <= 0.02),
+    ("HeaveObserver", "heave_cm"): ("≤ max(2 cm, 2.5 % of std) (issue 6)",
+                                    lambda s: s["heave_cm"] <= max(2.0, 0.025 * s["heave_std_cm"])),
+    ("HeaveObserver", "point_heave_cm"): ("≤ max(2 cm, 2.5 % of std) (issue 6)",
+                                          lambda s: s["point_heave_cm"] <= max(2.0, 0.025 * s["point_heave_std_cm"])),
+    **{("CentreOfRotation", f"cr_{a}_m"): ("≤ 0.1 m (issue 5)", lambda s, a=a: s[f"cr_{a}_m"] <= 0.1) for a in "xyz"},
+    **{("GnssAccFusion", f"pos_{a}_cm"): ("≤ 0.5 × raw GNSS (issue 4)",
+                                         lambda s, a=a: None if f"raw_gnss_{a}_cm" not in s else s[f"pos_{a}_cm"] <= 0.5 * s[f"raw_gnss_{a}_cm"])
+       for a in "ned"},
+    # issue 9: the goals are for the loop fed by a heave estimator (the winch that has vs_ideal/vs_classical)
+    ("AhcWinch", "residual_pct"): ("≤ 5 % when fed by the observer (issue 9)",
+                                   lambda s: None if "vs_ideal" not in s and "vs_classical" not in s else s["residual_pct"] <= 5.0),
+    ("AhcWinch", "vs_ideal"): ("≤ 1.5 (issue 9)", lambda s: s["vs_ideal"] <= 1.5),
+    ("AhcWinch", "vs_classical"): ("< 1 (issue 9)", lambda s: s["vs_classical"] < 1.0),
+    ("AhcWinch", "limited_pct"): ("≤ 1 % (issue 9)", lambda s: s["limited_pct"] <= 1.0),
+}
+LABELS = {
+    "roll_deg": "roll RMS error [deg]", "pitch_deg": "pitch RMS error [deg]",
+    "pos_n_cm": "COG north RMS error [cm]", "pos_e_cm": "COG east RMS error [cm]", "pos_d_cm": "COG down RMS error [cm]",
+    **{f"raw_gnss_{a}_cm": f"COG {w} from the antennas alone (raw GNSS), RMS error [cm]"
+       for a, w in zip("ned", ("north", "east", "down"))},
+    "heave_cm": "heave at the IMU, RMS error [cm]", "heave_std_cm": "true heave std at the IMU [cm]",
+    "point_heave_cm": "heave at the point, RMS error [cm]", "point_heave_std_cm": "true heave std at the point [cm]",
+    "cr_x_m": "centre of rotation x, RMS error [m]", "cr_y_m": "centre of rotation y, RMS error [m]",
+    "cr_z_m": "centre of rotation z, RMS error [m]",
+    "disp_n_cm": "COG north, centred estimate, RMS error [cm]", "disp_e_cm": "COG east, centred estimate, RMS error [cm]",
+    "disp_d_cm": "COG down, centred estimate, RMS error [cm]",
+    "valid_fraction": "fraction of the run with valid output", "scored_s": "time scored [s]",
+    "tip_heave_cm": "crane-tip heave std [cm]", "load_heave_cm": "load heave std [cm]",
+    "residual_pct": "load heave / tip heave [%]", "tip_motion_cm": "crane-tip vertical motion std, all frequencies [cm]",
+    "load_motion_cm": "load vertical motion std, all frequencies [cm]",
+    "residual_total_pct": "load / tip vertical motion, all frequencies [%]",
+    "vs_ideal": "residual / residual of the truth-fed loop", "vs_classical": "residual / residual of the classical-fed loop",
+    "limited_pct": "time with a winch limit acting [%]",
+    **{f"{n}_pct": f"time {n.replace('_', ' ')} [%]" for n in ("speed_limited", "acc_limited", "stroke_limited", "slack")},
+}
+
+
+def _png(fig) -> str:
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.tight_layout()
+    fig.savefig(buf, format="png", dpi=90)
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode()
+
+
+def _diagram(system: SystemDescription, plt) -> str:
+    """Boxes for the components (sources left, consumers right) and one arrow per linked pair."""
+    feeds: dict[tuple[str, str], int] = {}
+    for c in system.connections:
+        feeds[(c.start, c.end)] = feeds.get((c.start, c.end), 0) + 1
+    level = {c.name: 0 for c in system.components}
+    for _ in system.components:            # longest path from a source
+        for (a, b) in feeds:
+            level[b] = max(level[b], level[a] + 1)
+    columns: dict[int, list[str]] = {}
+    for name in level:
+        columns.setdefault(level[name], []).append(name)
+    pos = {n: (3.2 * lv, -1.2 * i + 0.6 * (len(col) - 1)) for lv, col in columns.items() for i, n in enumerate(col)}
+    fig, ax = plt.subplots(figsize=(10, 1.2 + 1.1 * max(len(c) for c in columns.values())))
+    kinds = {c.name: c.kind for c in system.components}
+    for (a, b), n in feeds.items():
+        (xa, ya), (xb, yb) = pos[a], pos[b]
+        ax.annotate("", xy=(xb - 1.1, yb), xytext=(xa + 1.1, ya), arrowprops={"arrowstyle": "->", "color": "0.4"})
+        ax.text((xa + xb) / 2, (ya + yb) / 2 + 0.1, f"{n}", fontsize=7, color="0.4", ha="center")
+    for n, (x, y) in pos.items():
+        ax.add_patch(plt.Rectangle((x - 1.1, y - 0.4), 2.2, 0.8, fc="#e8f0fa", ec="#3060a0"))
+        ax.text(x, y + 0.1, n, ha="center", fontsize=10, weight="bold")
+        ax.text(x, y - 0.22, kinds[n], ha="center", fontsize=8)
+    ax.set_xlim(-1.4, 3.2 * max(columns) + 1.4)
+    ax.set_ylim(min(p[1] for p in pos.values()) - 0.7, max(p[1] for p in pos.values()) + 0.7)
+    ax.axis("off")
+    ax.set_title("System: boxes are FMU instances, arrows carry the number of connected variables", fontsize=9)
+    return _png(fig)
+
+
+def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) -> list[tuple[str, str]]:
+    t = np.asarray(result["time"], dtype=float)
+    last = t >= t[-1] - 60.0
+    fields = set(result.dtype.names)
+
+    def g(name: str) -> np.ndarray:
+        return np.asarray(result[name], dtype=float)
+
+    out = []
+    for comp in system.components:
+        kind, c, v = comp.kind, comp.name, vessel
+        if kind == "AttitudeEstimator" and f"{c}.roll" in fields:
+            fig, ax = plt.subplots(2, 1, figsize=(10, 5.5))
+            for a, col in (("roll", "tab:blue"), ("pitch", "tab:orange")):
+                ax[0].plot(t[last], np.degrees(g(f"{v}.truth.{a}")[last]), color=col, lw=2, alpha=0.4, label=f"true {a}")
+                ax[0].plot(t[last], np.degrees(g(f"{c}.{a}")[last]), color=col, lw=0.9, label=f"estimated {a}")
+                ax[1].plot(t, np.degrees(g(f"{c}.{a}") - g(f"{v}.truth.{a}")), color=col, lw=0.6, label=a)
+            ax[0].set_ylabel("angle [deg]")
+            ax[0].legend(loc="upper right", ncol=4, fontsize=8)
+            ax[1].set_ylabel("error [deg]")
+            ax[1].set_xlabel("time [s]")
+            ax[1].legend(loc="upper right", fontsize=8)
+            settled = t >= t[0] + 60.0
+            if settled.any():     # scale to the settled error, not the start transient
+                worst = max(float(np.max(np.abs(np.degrees(g(f"{c}.{a}") - g(f"{v}.truth.{a}"))[settled])))
+                            for a in ("roll", "pitch"))
+                if math.isfinite(worst) and worst > 0:
+                    ax[1].set_ylim(-1.5 * worst, 1.5 * worst)
+            out.append((f"{c}: roll and pitch, the last minute and the error over the run", _png(fig)))
+        elif kind == "HeaveObserver" and f"{c}.heave" in fields:
+            valid = np.asarray(result[f"{c}.valid"], dtype=bool)
+            fig, ax = plt.subplots(2, 1, figsize=(10, 5.5), sharex=True)
+            for i, (est, truth, label) in enumerate(((f"{c}.heave", f"{v}.truth.imu.d", "IMU"),
+                                                     (f"{c}.point.heave", f"{v}.truth.point.d", "monitoring point"))):
+                if est not in fields or truth not in fields:
+                    continue
+                tr = g(truth)
+                tr = tr - tr[valid].mean() if valid.any() else tr
+                ax[i].plot(t[last], -tr[last], "k", lw=2, alpha=0.4, label="truth")
+                ax[i].plot(t[last], -g(est)[last], lw=0.9, label="real-time estimate")
+                ax[i].set_ylabel(f"heave at the {label} [m, up]")
+                ax[i].legend(loc="upper right", fontsize=8)
+            ax[1].set_xlabel("time [s]")
+            out.append((f"{c}: heave in real time against the truth, the last minute", _png(fig)))
+            if valid.sum() > 2048:
+                from scipy import signal
+
+                dt = t[1] - t[0]
+                tr = g(f"{v}.truth.imu.d")[valid]
+                seg = min(int(valid.sum()), int(round(200.0 / dt)))       # 200 s segments: 0.03 rad/s bins
+                f, p_true = signal.welch(tr - tr.mean(), fs=1.0 / dt, nperseg=seg)
+                _, p_est = signal.welch(g(f"{c}.heave")[valid], fs=1.0 / dt, nperseg=seg)
+                _, p_err = signal.welch(g(f"{c}.heave")[valid] - (tr - tr.mean()), fs=1.0 / dt, nperseg=seg)
+                fig, ax = plt.subplots(figsize=(10, 3.8))
+                w = 2 * math.pi * f
+                for p, label in ((p_true, "truth"), (p_est, "estimate"), (p_err, "error")):
+                    ax.semilogy(w[1:], p[1:], lw=1.2, label=label)
+                ax.set_xlim(0, 3)
+                ax.set_ylim(1e-7 * p_true.max(), 3 * p_true.max())
+                ax.set_xlabel("ω [rad/s]")
+                ax.set_ylabel("heave PSD [m²/Hz]")
+                ax.legend(fontsize=8)
+                out.append((f"{c}: heave spectra at the IMU (Welch) while valid", _png(fig)))
+        elif kind == "GnssAccFusion" and f"{c}.pos.d" in fields:
+            fig, ax = plt.subplots(2, 1, figsize=(10, 5.5))
+            for a, col in (("n", "tab:blue"), ("e", "tab:orange"), ("d", "tab:green")):
+                ax[0].plot(t[last], g(f"{v}.truth.cog.{a}")[last], color=col, lw=2, alpha=0.4, label=f"true {a}")
+                ax[0].plot(t[last], g(f"{c}.pos.{a}")[last], color=col, lw=0.9, label=f"fused {a}")
+                ax[1].plot(t, 100 * (g(f"{c}.pos.{a}") - g(f"{v}.truth.cog.{a}")), color=col, lw=0.6, label=a)
+            ax[0].set_ylabel("COG position [m, NED]")
+            ax[0].legend(loc="upper right", ncol=3, fontsize=8)
+            ax[1].set_ylabel("error [cm]")
+            ax[1].set_ylim(-5, 5)
+            ax[1].set_xlabel("time [s]")
+            ax[1].legend(loc="upper right", fontsize=8)
+            out.append((f"{c}: GNSS + accelerometer fused COG position, the last minute and the error", _png(fig)))
+        elif kind == "CentreOfRotation" and f"{c}.cr.x" in fields:
+            fig, ax = plt.subplots(figsize=(10, 3.8))
+            for a in "xyz":
+                line, = ax.plot(t, g(f"{c}.cr.{a}"), lw=1.0, label=f"estimated {a}")
+                if f"{v}.truth.cr.{a}" in fields and np.asarray(result[f"{v}.truth.cr.defined"], dtype=bool).any():
+                    ax.plot(t, g(f"{v}.truth.cr.{a}"), "--", color=line.get_color(), lw=1.0, label=f"true {a}")
+            ax.set_ylabel("centre of rotation [m, body, from COG]")
+            ax.set_xlabel("time [s]")
+            ax.legend(loc="upper right", ncol=3, fontsize=8)
+            out.append((f"{c}: convergence of the centre of rotation (settled running mean)", _png(fig)))
+        elif kind == "DisplacementReconstructor" and f"{c}.centred.disp.d" in fields:
+            delay = float(g(f"{c}.centred.delay")[-1])
+            lag = int(round(delay / (t[1] - t[0])))
+            valid = np.asarray(result[f"{c}.valid"], dtype=bool)
+            window = last & valid
+            if window.any() and lag < len(t):
+                fig, ax = plt.subplots(figsize=(10, 3.8))
+                k = np.flatnonzero(window)
+                k = k[k >= lag]
+                for a, col in (("n", "tab:blue"), ("e", "tab:orange"), ("d", "tab:green")):
+                    truth, est = g(f"{v}.truth.cog.{a}")[k - lag], g(f"{c}.centred.disp.{a}")[k]
+                    ax.plot(t[k - lag], truth - truth.mean(), color=col, lw=2, alpha=0.4, label=f"true COG {a}")
+                    ax.plot(t[k - lag], est - est.mean(), color=col, lw=0.9, label=f"reconstructed {a}")
+                ax.set_ylabel("displacement about the mean [m, NED]")
+                ax.set_xlabel(f"time [s] (the estimate is available {delay:g} s later)")
+                ax.legend(loc="upper right", ncol=3, fontsize=8)
+                out.append((f"{c}: COG displacement reconstructed from acceleration alone (no GNSS), centred "
+                            f"window estimate, {delay:g} s behind real time", _png(fig)))
+    winches = [c.name for c in system.components if c.kind == "AhcWinch" and f"{c.name}.load.d" in fields]
+    tip = f"{vessel}.truth.point.d"
+    if winches and tip in fields:
+        fig, ax = plt.subplots(figsize=(10, 3.8))
+        ax.plot(t[last], -(g(tip)[last] - g(tip)[last].mean()), "k", lw=2, alpha=0.4, label="crane tip")
+        for w in winches:
+            load = g(f"{w}.load.d")[last]
+            ax.plot(t[last], -(load - load.mean()), lw=0.9, label=f"load, {w}")
+        ax.set_ylabel("vertical motion about the mean [m, up]")
+        ax.set_xlabel("time [s]")
+        ax.legend(loc="upper right", ncol=3, fontsize=8)
+        out.append(("heave compensation: the crane tip and each winch's load, the last minute", _png(fig)))
+    return out
+
+
+def accuracy_rows(system: SystemDescription, scores: dict[str, dict[str, float]]) -> list[tuple[str, str, float, str, str]]:
+    """(component, metric label, value, goal, status) rows of the accuracy table; status is
+    ``met``, ``not met`` or empty when the issue tracker gives no goal."""
+    kinds = {c.name: c.kind for c in system.components}
+    rows = []
+    for comp, metrics in scores.items():
+        for metric, value in metrics.items():
+            goal = GOALS.get((kinds[comp], metric))
+            verdict = None if goal is None or not math.isfinite(value) else goal[1](metrics)
+            status = "" if verdict is None else ("met" if verdict else "not met")
+            rows.append((comp, LABELS.get(metric, metric), value, goal[0] if goal else "", status))
+    return rows
+
+
+def write_report(result: np.ndarray, system: SystemDescription, scores: dict[str, dict[str, float]], vessel: str,
+                 out_dir: str | Path, title: str, description: str) -> Path:
+    """Write ``report.html`` in ``out_dir`` (module docstring); return its path."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    t = np.asarray(result["time"], dtype=float)
+    rows = accuracy_rows(system, scores)
+    table = "\n".join(
+        f"<tr><td>{html.escape(c)}</td><td>{html.escape(m)}</td><td class='num'>{v:.4g}</td>"
+        f"<td>{html.escape(g)}</td><td class='{s.replace(' ', '')}'>{s}</td></tr>" for c, m, v, g, s in rows)
+    figures = [("system", _diagram(system, plt))] + _figures(result, system, vessel, plt)
+    body = "\n".join(f"<figure><img src='data:image/png;base64,{png}'><figcaption>{html.escape(cap)}</figcaption></figure>"
+                     for cap, png in figures)
+    page = f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
+<style>
+body {{ font-family: sans-serif; max-width: 1000px; margin: 2em auto; color: #222; }}
+table {{ border-collapse: collapse; margin: 1em 0; }} td, th {{ border: 1px solid #ccc; padding: 3px 8px; }}
+td.num {{ text-align: right; font-family: monospace; }} td.met {{ color: #176b2c; font-weight: bold; }}
+td.notmet {{ color: #a01818; font-weight: bold; }} figure {{ margin: 1.5em 0; }} img {{ max-width: 100%; }}
+figcaption {{ font-size: 0.9em; color: #555; }}
+</style></head><body>
+<h1>{html.escape(title)}</h1>
+<p>{html.escape(description)}</p>
+<p>{len(system.components)} FMUs, {len(system.connections)} connections, {t[-1] - t[0]:g} s simulated at a
+{system.step:g} s base step. Estimates are scored against the exact truth of <b>{html.escape(vessel)}</b>
+from 60 s after each estimator first reports <code>valid</code>, on its valid samples (RMS errors).</p>
+<h2>Accuracy against the goals</h2>
+<table><tr><th>component</th><th>quantity</th><th>value</th><th>goal</th><th></th></tr>
+{table}
+</table>
+<h2>Figures</h2>
+{body}
+</body></html>
+"""
+    path = out / "report.html"
+    path.write_text(page, encoding="utf-8")
+    return path

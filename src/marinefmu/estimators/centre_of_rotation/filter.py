@@ -1,0 +1,520 @@
+"""Centre of rotation (CR) of a ship by a Kalman filter with lever-arm states (paper 002,
+Zhang, Härting, Ntamba & Schwarz-Röhr).
+
+The CR is the point whose linear acceleration is not affected by the rotations. A sensor at
+offset ``o`` from the CR (here o = CR − sensor, body frame, DESIGN.md) reads the specific force
+
+.. math::
+    f_b = R_{nb}^T (a_{CR} - g_n) - (α × o + ω × (ω × o))
+
+with a_CR the CR's acceleration in NED, ω_b and α_b the body angular rate and acceleration.
+This is paper 002's eq. 11 (``u = R_n^b (a_n + g) + α × r``, eqs. 6-10) converted to our
+NED/FRD convention: the paper's frames are z-up/y-port (a rotation of π about x from ours, so
+φ, a_x keep their sign, θ, ψ, a_y, a_z flip), its offset r points from the CR to the sensor
+(r = −o), and its gravity enters with the opposite sign because its z axis points up
+(:func:`eq11_specific_force` is the paper's formula as printed, tested against ours).
+Two differences, each selectable:
+
+* **Centripetal term.** The paper's eq. 10 keeps only α × r; the full rigid-body term adds
+  ω × (ω × r) (``centripetal=True``, default; ``False`` is the paper's model).
+* **Yaw terms.** Eq. 11 as printed also drops the ψ̈ terms of its own eq. 10 and uses the
+  Euler-angle accelerations (φ̈, θ̈) in place of the body angular acceleration. We always use the
+  full cross product with α_b, the derivative of the body rates (exact; equal to the paper's
+  form for small angles and no yaw motion).
+
+**Filter** (eqs. 1-5, filterpy ``KalmanFilter``): state s = [a_CR (N, E, D), o (x, y, z)], a
+random walk (F = I, eq. 1) with process-noise densities ``acc_rw`` and ``offset_rw``;
+measurement z = f_b + R_nbᵀ g_n = H s with the time-varying H = [R_nbᵀ, −M(ω, α)],
+M = [α×] + [ω×]² (eq. 11); Joseph-form covariance update (eq. 5, filterpy's default).
+The offset is identifiable only statistically: the filter finds the point whose acceleration
+is uncorrelated with α. Over a finite record the CR's acceleration and the rotation have a
+non-zero sample correlation, so even with exact data the estimate scatters about the true CR by
+roughly corr · σ(a_CR)/σ(α) (metres for a ship in a 10-minute record; see
+:func:`offset_floor`). Two sensors on one rigid body share that error, so their CR estimates
+agree far better than either agrees with the truth: paper 002's "internally unique" result.
+
+**Angles** (paper section 3.2, ``angles="gyro_hp"``): the Euler-angle rates T(Θ)ω_b are
+integrated through a first-order high-pass of cutoff ``hp_cutoff`` (a leaky integrator
+1/(s + ω_c), the integral followed by the high-pass s/(s + ω_c), discretised exactly for a
+rate held over the step). The high-pass removes gyro-bias drift but distorts the wave-band
+angles (gain 1/√(1 + (ω_c/ω)²), phase lead atan(ω_c/ω)), and the angle error couples gravity
+into the horizontal axes. ``angles="input"`` takes roll, pitch, yaw from an attitude estimator
+(or truth) instead.
+
+**Angular acceleration** by filtered differentiation of the gyro rates: a centred
+Savitzky–Golay derivative over ``diff_window`` seconds (:mod:`.centred_window`); every signal is
+taken at the window centre, so the filter runs ``delay`` = diff_window/2 behind the newest
+sample, without phase error between α and the accelerations. The paper does not say how it
+differentiates.
+
+Outputs: the offset and its standard deviation (filter covariance), its running mean after
+``settle_time`` (the paper averages "after the Kalman filter has reached a settled state"), the
+CR relative to the COG for a sensor at ``sensor`` (COG frame), the specific force a sensor at
+the CR would read (acc_cr, body) and the CR's acceleration (NED).
+
+Not from a library: the Savitzky–Golay weights are scipy's; the filter is filterpy's; only the
+measurement matrix and the leaky angle integrator are written here.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+
+from ...errors import ParameterTypeError, check_choice, check_range, check_vector
+from ...frames import GRAVITY_N, G, body_to_euler_rates, rigid_point_operator, rot_nb
+from .centred_window import CentredWindow, window_samples
+from ..samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
+
+log = logging.getLogger(__name__)
+
+ANGLE_CHOICES = ("gyro_hp", "input")
+#: Order of the Savitzky–Golay fit. The derivative's gain error grows as (ωT)^(order): order 2
+#: over 0.5 s loses 1 % of α at 0.2 Hz (0.13 m on a 13 m offset), order 4 over the default 1.5 s
+#: loses 0.16 % at 0.2 Hz and 0.8 % at 0.3 Hz while averaging the gyro noise enough that it does
+#: not shrink the offset (noise in α biases the estimate towards the sensor).
+POLYORDER = 4
+
+
+@dataclass(frozen=True)
+class CentreOfRotationParams:
+    """Parameters of :class:`CentreOfRotation` (FMU names in brackets).
+
+    Parameters
+    ----------
+    angles : str
+        ``"gyro_hp"`` high-pass integrated gyro rates (paper section 3.2, default) or
+        ``"input"`` roll/pitch/yaw given to :meth:`CentreOfRotation.step`. [``angles``]
+    hp_cutoff : float
+        Cutoff of the angle high-pass [Hz], (0, 1]. [``hp_cutoff``]
+    diff_window : float
+        Length of the Savitzky–Golay differentiation window [s], (0, 10]; the estimator runs
+        half of it behind the newest sample. [``diff_window``]
+    centripetal : bool
+        Include ω × (ω × o) in the lever-arm term (False: the paper's α × r only). [``centripetal``]
+    acc_sigma : float
+        Standard deviation of one specific-force sample in the measurement model [m/s²],
+        (0, 10]: sensor noise plus g times the angle error. [``acc_sigma``]
+    acc_rw : float
+        Random-walk density of the CR acceleration states [m/s²/√s], (0, 100]. [``acc_rw``]
+    offset_rw : float
+        Random-walk density of the offset states [m/√s], (0, 10]. [``offset_rw``]
+    offset_sigma0 : float
+        Initial standard deviation of the offset [m], (0, 1000]. [``offset_sigma0``]
+    settle_time : float
+        Time after which the offset is averaged [s], [0, 1e6]. [``settle_time``]
+    sensor : tuple of float
+        Sensor position relative to the COG, body frame [m], to report the CR relative to the
+        COG. [``sensor.{x,y,z}``]
+    """
+
+    angles: str = "gyro_hp"
+    hp_cutoff: float = 0.005
+    diff_window: float = 1.5
+    centripetal: bool = True
+    acc_sigma: float = 0.02
+    acc_rw: float = 0.05
+    offset_rw: float = 1e-3
+    offset_sigma0: float = 10.0
+    settle_time: float = 120.0
+    sensor: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        check_choice("angles", self.angles, ANGLE_CHOICES)
+        check_range("hp_cutoff", self.hp_cutoff, lo=0.0, hi=1.0, lo_open=True, unit="Hz")
+        check_range("diff_window", self.diff_window, lo=0.0, hi=10.0, lo_open=True, unit="s")
+        if not isinstance(self.centripetal, (bool, np.bool_)):
+            raise ParameterTypeError(f"centripetal must be True or False, got {self.centripetal!r}")
+        check_range("acc_sigma", self.acc_sigma, lo=0.0, hi=10.0, lo_open=True, unit="m/s2")
+        check_range("acc_rw", self.acc_rw, lo=0.0, hi=100.0, lo_open=True, unit="m/s2/sqrt(s)")
+        check_range("offset_rw", self.offset_rw, lo=0.0, hi=10.0, lo_open=True, unit="m/sqrt(s)")
+        check_range("offset_sigma0", self.offset_sigma0, lo=0.0, hi=1000.0, lo_open=True, unit="m")
+        check_range("settle_time", self.settle_time, lo=0.0, hi=1e6, unit="s")
+        check_vector("sensor", self.sensor, unit="m")
+
+
+# ---- stateless kernel -----------------------------------------------------------------------
+def lever_matrix(omega: Any, alpha: Any, centripetal: bool = True) -> np.ndarray:
+    """M with M·o = α × o (+ ω × (ω × o) if ``centripetal``), body frame.
+
+    Parameters
+    ----------
+    omega : array_like
+        (3,) body angular rate [rad/s].
+    alpha : array_like
+        (3,) body angular acceleration [rad/s²].
+    centripetal : bool
+        Include the centripetal part [ω×]² (the paper's eq. 10 omits it).
+    """
+    w = list(omega) if centripetal else [0.0, 0.0, 0.0]
+    return rigid_point_operator(w, list(alpha))[6:9]
+
+
+def measurement_matrix(rot: np.ndarray, omega: Any, alpha: Any, centripetal: bool = True) -> np.ndarray:
+    """(3, 6) H of eq. 11 in NED/FRD: z = f_b + R_nbᵀ g_n = H [a_CR; o].
+
+    Parameters
+    ----------
+    rot : numpy.ndarray
+        (3, 3) R_nb.
+    omega, alpha : array_like
+        (3,) body angular rate [rad/s] and acceleration [rad/s²].
+    centripetal : bool
+        See :func:`lever_matrix`.
+    """
+    return np.hstack((rot.T, -lever_matrix(omega, alpha, centripetal)))
+
+
+def predicted_specific_force(rot: np.ndarray, acc_cr: Any, offset: Any, omega: Any, alpha: Any,
+                             centripetal: bool = True) -> np.ndarray:
+    """Specific force at a sensor whose CR is at ``offset`` [m, b]: R_nbᵀ (a_CR − g_n) − M o [m/s², b].
+
+    Parameters
+    ----------
+    rot : numpy.ndarray
+        (3, 3) R_nb.
+    acc_cr : array_like
+        (3,) acceleration of the CR [m/s², NED].
+    offset : array_like
+        (3,) CR relative to the sensor [m, b].
+    omega, alpha : array_like
+        (3,) body angular rate [rad/s] and acceleration [rad/s²].
+    centripetal : bool
+        See :func:`lever_matrix`.
+    """
+    s = np.concatenate((np.asarray(acc_cr, dtype=float), np.asarray(offset, dtype=float)))
+    return measurement_matrix(rot, omega, alpha, centripetal) @ s - rot.T @ GRAVITY_N
+
+
+def eq11_specific_force(euler: Any, euler_ddot: Any, acc_n: Any, r: Any, g: float = G) -> np.ndarray:
+    """Paper 002's eq. 11 exactly as printed, in the paper's frames (x bow, y port, z up).
+
+    Parameters
+    ----------
+    euler : array_like
+        Paper roll, pitch, yaw [rad] (eqs. 7-9).
+    euler_ddot : array_like
+        φ̈, θ̈, ψ̈ [rad/s²] (ψ̈ is unused: eq. 11 drops it).
+    acc_n : array_like
+        (ax_n, ay_n, az_n): acceleration of the CR in the paper's earth frame [m/s²].
+    r : array_like
+        (r_x, r_y, r_z): offset of the sensor from the CR, paper body frame [m].
+    g : float
+        Gravity [m/s²].
+
+    Returns
+    -------
+    numpy.ndarray
+        (ax_sensor, ay_sensor, az_sensor) [m/s²], paper body frame.
+    """
+    f, t, p = euler
+    fdd, tdd, _ = euler_ddot
+    ax, ay, az = acc_n
+    rx, ry, rz = r
+    sf, cf, st, ct, sp, cp = math.sin(f), math.cos(f), math.sin(t), math.cos(t), math.sin(p), math.cos(p)
+    return np.array([
+        ax * ct * cp + ay * ct * sp - az * st - g * st + rz * tdd,
+        ax * (sf * st * cp - cf * sp) + ay * (sf * st * sp + cf * cp) + az * sf * ct + g * sf * ct - rz * fdd,
+        ax * (cf * st * cp + sf * sp) + ay * (cf * st * sp - sf * cp) + az * cf * ct + g * cf * ct + ry * fdd - rx * tdd,
+    ])
+
+
+def offset_floor(acc_cr: np.ndarray, rot: np.ndarray, omega: np.ndarray, alpha: np.ndarray,
+                 centripetal: bool = True) -> np.ndarray:
+    """Offset error that the sample correlation of the CR acceleration with the rotation alone
+    causes over a record [m, b]: the floor of any estimator built on their independence.
+
+    With exact data, z_k = R_kᵀ a_CR,k − M_k o. The filter's random-walk model of a_CR (eq. 1)
+    with a small measurement noise makes it, in effect, a least-squares fit of the *increments*
+    Δz_k on −ΔM_k, so its offset settles at o − (Σ ΔMᵀΔM)⁻¹ Σ ΔMᵀ Δ(Rᵀ a_CR): this function
+    returns that error term. It vanishes only as the sample correlation averages out (slowly:
+    with the line spectra of a simulated sea, not even as 1/√T).
+
+    Parameters
+    ----------
+    acc_cr : numpy.ndarray
+        (N, 3) true acceleration of the CR [m/s², NED].
+    rot : numpy.ndarray
+        (N, 3, 3) true R_nb.
+    omega, alpha : numpy.ndarray
+        (N, 3) true body angular rate [rad/s] and acceleration [rad/s²].
+    centripetal : bool
+        See :func:`lever_matrix`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (3,) estimate minus true offset [m, b].
+    """
+    m = np.diff(np.array([lever_matrix(w, a, centripetal) for w, a in zip(omega, alpha)]), axis=0)
+    b = np.diff(np.einsum("kji,kj->ki", rot, acc_cr), axis=0)
+    return -np.linalg.lstsq(m.reshape(-1, 3), b.reshape(-1), rcond=None)[0]
+
+
+def leaky_angle_step(euler: list[float], rate: list[float], dt: float, cutoff: float) -> list[float]:
+    """One step of the high-pass angle integrator (paper section 3.2): Θ̇ = T(Θ)ω − ω_c Θ,
+    exact for the Euler rate held over the step.
+
+    Parameters
+    ----------
+    euler : list of float
+        [φ, θ, ψ] at the start of the step [rad].
+    rate : list of float
+        Body angular rate over the step [rad/s].
+    dt : float
+        Step [s].
+    cutoff : float
+        High-pass cutoff [Hz].
+    """
+    wc = 2.0 * math.pi * cutoff
+    decay = math.exp(-wc * dt)
+    gain = -math.expm1(-wc * dt) / wc
+    return [decay * e + gain * d for e, d in zip(euler, body_to_euler_rates(euler, rate))]
+
+
+# ---- stateful estimator ---------------------------------------------------------------------
+@dataclass(frozen=True)
+class CentreOfRotationResult:
+    """Output of one :meth:`CentreOfRotation.step` (all at ``delay`` before the newest sample).
+
+    Attributes
+    ----------
+    offset, offset_std, offset_mean : tuple of float
+        CR relative to the sensor, its standard deviation, and its running mean after
+        ``settle_time`` (the current estimate before) [m, b].
+    cr : tuple of float
+        CR relative to the COG from the mean offset: ``sensor + offset_mean`` [m, b].
+    acc_cr : tuple of float
+        Specific force a sensor at the CR would read [m/s², b].
+    acc_cr_n : tuple of float
+        Acceleration of the CR [m/s², NED] (the filter's a_CR states).
+    euler : tuple of float
+        Roll, pitch, yaw used [rad].
+    ang_acc : tuple of float
+        Angular acceleration used [rad/s², b].
+    delay : float
+        How far the estimate lags the newest sample [s].
+    valid : bool
+        Window full and the sample good.
+    settled : bool
+        ``settle_time`` has passed, so ``offset_mean`` is an average.
+    warning : str or None
+        Why the sample was rejected, if it was.
+    """
+
+    offset: tuple[float, float, float]
+    offset_std: tuple[float, float, float]
+    offset_mean: tuple[float, float, float]
+    cr: tuple[float, float, float]
+    acc_cr: tuple[float, float, float]
+    acc_cr_n: tuple[float, float, float]
+    euler: tuple[float, float, float]
+    ang_acc: tuple[float, float, float]
+    delay: float
+    valid: bool
+    settled: bool
+    warning: str | None = None
+
+
+def _bad_sample(acc: np.ndarray, gyro: np.ndarray, euler: np.ndarray | None) -> str | None:
+    if not (np.all(np.isfinite(acc)) and np.all(np.isfinite(gyro))):
+        return "non-finite acc or gyro sample"
+    if euler is not None:
+        if not np.all(np.isfinite(euler)):
+            return "non-finite roll, pitch or yaw input"
+        if reason := angles_beyond_limit(euler):
+            return f"{reason} (input)"
+    return rate_beyond_limit(gyro) or force_beyond_limit(acc)
+
+
+class CentreOfRotation:
+    """Kalman estimate of the CR offset from a strapdown IMU (module docstring).
+
+    Parameters
+    ----------
+    params : CentreOfRotationParams, optional
+        Validated parameters (defaults if omitted).
+
+    Examples
+    --------
+    >>> est = CentreOfRotation(CentreOfRotationParams(diff_window=0.04))
+    >>> r = est.step([0.0, 0.0, -9.80665], [0.0, 0.0, 0.0], 0.01)
+    >>> r.valid, r.delay     # filling the differentiation window
+    (False, 0.02)
+    """
+
+    def __init__(self, params: CentreOfRotationParams | None = None) -> None:
+        self.params = params or CentreOfRotationParams()
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the initial state."""
+        p = self.params
+        self.dt: float | None = None
+        self.window: CentredWindow | None = None
+        self.euler = [0.0, 0.0, 0.0]
+        self.last: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None
+        self.filtered_time = 0.0
+        self.mean_sum = np.zeros(3)
+        self.mean_count = 0
+        self.kf = KalmanFilter(dim_x=6, dim_z=3)
+        self.kf.P = np.diag([1.0] * 3 + [p.offset_sigma0 ** 2] * 3)
+        self.kf.R = np.eye(3) * p.acc_sigma ** 2
+        self._result = self._output(None, np.zeros(3), [0.0, 0.0, 0.0], False, None)
+
+    def _start(self, dt: float) -> None:
+        p = self.params
+        self.dt = dt
+        self.window = CentredWindow(9, window_samples(p.diff_window, dt, POLYORDER), dt, POLYORDER)
+        self.kf.Q = np.diag([p.acc_rw ** 2 * dt] * 3 + [p.offset_rw ** 2 * dt] * 3)
+
+    def step(self, acc: Any, gyro: Any, dt: float, euler: Any = None) -> CentreOfRotationResult:
+        """Process one sample.
+
+        Parameters
+        ----------
+        acc : array_like
+            (3,) specific force at the sensor at the end of the step [m/s², b].
+        gyro : array_like
+            (3,) angular rate at the end of the step [rad/s, b].
+        dt : float
+            Step [s] (> 0, constant; a change restarts the differentiation window).
+        euler : array_like, optional
+            Roll, pitch, yaw [rad] for ``angles="input"`` (ignored otherwise).
+
+        Returns
+        -------
+        CentreOfRotationResult
+            Refers to ``delay`` s before this sample. A non-finite or absurd sample is replaced
+            by the last good one (hold): ``valid`` is False and ``warning`` says why.
+        """
+        p = self.params
+        acc = np.asarray(acc, dtype=float)
+        gyro = np.asarray(gyro, dtype=float)
+        ang = np.asarray(euler, dtype=float) if p.angles == "input" else None
+        if p.angles == "input" and (ang is None or ang.shape != (3,)):
+            ang = np.full(3, math.nan)
+        warning = _bad_sample(acc, gyro, ang)
+        if warning is not None:
+            log.warning("centre of rotation: %s; holding the last good sample", warning)
+            if self.last is None:
+                return self._invalid(warning)
+            acc, gyro, ang = self.last
+        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
+            warning = f"step size changed from {self.dt} s to {dt} s; differentiation window restarted"
+            log.warning("centre of rotation: %s", warning)
+            self.dt = None
+        prev = self.last
+        self.last = (acc, gyro, ang)
+        if self.dt is None:
+            self._start(dt)
+        if ang is None:
+            rate = gyro if prev is None else 0.5 * (gyro + prev[1])
+            self.euler = leaky_angle_step(self.euler, rate.tolist(), dt, p.hp_cutoff)
+            ang = np.array(self.euler)
+        centre = self.window.push(np.concatenate((gyro, acc, ang)))
+        if centre is None:
+            return self._invalid(warning)
+        raw, smooth, deriv = centre
+        omega, alpha, f_b, angles = smooth[0:3], deriv[0:3], raw[3:6], raw[6:9].tolist()
+        rot = rot_nb(*angles)
+        kf = self.kf
+        kf.predict()
+        # set H rather than pass it: filterpy's update() reshapes z to a column only when H is None
+        kf.H = measurement_matrix(rot, omega, alpha, p.centripetal)
+        kf.update(f_b + rot.T @ GRAVITY_N)
+        self.filtered_time += dt
+        if self.filtered_time >= p.settle_time - 1e-9:
+            self.mean_sum += kf.x[3:6, 0]
+            self.mean_count += 1
+        self._result = self._output(f_b, alpha, angles, warning is None, warning)
+        return self._result
+
+    def _invalid(self, warning: str | None) -> CentreOfRotationResult:
+        return replace(self._result, delay=self.delay, valid=False, warning=warning)
+
+    @property
+    def delay(self) -> float:
+        """Lag of the estimate behind the newest sample [s] (half the differentiation window)."""
+        return self.window.delay if self.window is not None else 0.0
+
+    def _output(self, f_b: np.ndarray | None, alpha: np.ndarray, angles: list[float], valid: bool,
+                warning: str | None) -> CentreOfRotationResult:
+        x = self.kf.x[:, 0]
+        offset = x[3:6]
+        std = np.sqrt(np.diag(self.kf.P)[3:6])
+        mean = self.mean_sum / self.mean_count if self.mean_count else offset
+        # what a sensor at the CR would read: f_b + M o, with −M the offset block of this step's H
+        acc_cr = np.zeros(3) if f_b is None else f_b - self.kf.H[:, 3:6] @ offset
+        t = lambda v: tuple(float(a) for a in v)  # noqa: E731
+        return CentreOfRotationResult(
+            t(offset), t(std), t(mean), t(np.asarray(self.params.sensor) + mean), t(acc_cr), t(x[0:3]), t(angles),
+            t(alpha), self.delay, valid, self.mean_count > 0, warning,
+        )
+
+    # ---- FMU state ---------------------------------------------------------------------------
+    def get_state(self) -> dict:
+        """JSON-serialisable internal state."""
+        last = None if self.last is None else [None if v is None else v.tolist() for v in self.last]
+        return {
+            "dt": self.dt, "window": None if self.window is None else self.window.get_state(),
+            "euler": list(self.euler), "last": last, "filtered_time": self.filtered_time,
+            "mean_sum": self.mean_sum.tolist(), "mean_count": self.mean_count,
+            "kf_x": self.kf.x.tolist(), "kf_P": self.kf.P.tolist(),
+        }
+
+    def set_state(self, s: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.reset()
+        if s["dt"] is not None:
+            self._start(float(s["dt"]))
+            self.window.set_state(s["window"])
+        self.euler = [float(v) for v in s["euler"]]
+        self.last = None if s["last"] is None else tuple(None if v is None else np.array(v) for v in s["last"])
+        self.filtered_time = float(s["filtered_time"])
+        self.mean_sum, self.mean_count = np.array(s["mean_sum"]), int(s["mean_count"])
+        self.kf.x, self.kf.P = np.array(s["kf_x"]), np.array(s["kf_P"])
+
+
+def estimate_centre_of_rotation(acc: np.ndarray, gyro: np.ndarray, dt: float,
+                                params: CentreOfRotationParams | None = None,
+                                euler: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Run :class:`CentreOfRotation` over whole records.
+
+    Parameters
+    ----------
+    acc, gyro : numpy.ndarray
+        (N, 3) specific force [m/s², b] and angular rate [rad/s, b] at t_k = (k + 1)·dt.
+    dt : float
+        Sample interval [s].
+    params : CentreOfRotationParams, optional
+        Defaults to :class:`CentreOfRotationParams` ().
+    euler : numpy.ndarray, optional
+        (N, 3) roll, pitch, yaw [rad] for ``angles="input"``.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``offset``, ``offset_std``, ``offset_mean``, ``cr``, ``acc_cr``, ``acc_cr_n``, ``euler``,
+        ``ang_acc`` (N, 3); ``valid``, ``settled`` (N,) bool; ``delay`` (float, s). Row k refers
+        to the time t_k − delay.
+    """
+    acc = np.asarray(acc, dtype=float)
+    gyro = np.asarray(gyro, dtype=float)
+    est = CentreOfRotation(params)
+    n = len(acc)
+    vec_fields = ("offset", "offset_std", "offset_mean", "cr", "acc_cr", "acc_cr_n", "euler", "ang_acc")
+    out: dict[str, Any] = {f: np.empty((n, 3)) for f in vec_fields}
+    out["valid"] = np.empty(n, dtype=bool)
+    out["settled"] = np.empty(n, dtype=bool)
+    for k in range(n):
+        r = est.step(acc[k], gyro[k], dt, None if euler is None else euler[k])
+        for f in vec_fields:
+            out[f][k] = getattr(r, f)
+        out["valid"][k], out["settled"][k] = r.valid, r.settled
+    out["delay"] = est.delay
+    return out

@@ -1,0 +1,396 @@
+"""The ``model="wiener"`` heave estimator (beyond paper 003): the causal Wiener FIR filter
+from vertical acceleration to heave, designed from the measured spectrum.
+
+Why. The band observer (:mod:`.band_bank`) is the Wiener filter of its *model*; its
+resonators spread each element's variance over a skirt, most harmfully below the sea's low
+edge, where the model then claims heave that is not there and the filter lets accelerometer
+noise through (Hs 4 m / Tp 12 s: 1.9 cm of its 2.3 cm error below 0.2 rad/s, against 1.3 cm
+for the best causal filter, :func:`~marinefmu.papers.paper003.causal_bound`). Here the
+filter is designed from the spectrum itself, with no model shape in between.
+
+Design, at every ``peak_interval`` after the first ``window`` (the window grows to
+``window_max`` as in :class:`.heave.HeaveObserver`):
+
+1. The acceleration spectrum S_ä of the window (:func:`~.wave_peaks.acceleration_spectrum`)
+   less the sensor's noise S_n(ω) = N²/π + q²/(πω²) (``acc_noise`` N, white; ``offset_noise``
+   q, the bias as a random walk; one-sided densities per rad/s), averaged over
+   ±:data:`SMOOTHING`/2 of the frequency (⟨·⟩), gives the sea's heave spectrum
+   S_z(ω) = max(⟨S_ä − S_n⟩, 0)/ω⁴ on [``omega_min``, ``omega_max``], zero elsewhere
+   (:func:`sea_heave_density`). No ``band_min``: the subtraction finds the sea's low edge.
+2. The taps act on block means ā of the acceleration over :data:`BLOCK` s, every
+   :data:`BLOCK` s back over :data:`MEMORY` s (or as far as the data go). Their Wiener-Hopf equations R w = r are
+   Toeplitz (``scipy.linalg.solve_toeplitz``, Levinson): R, the autocorrelation of ā under
+   the model (sea plus noise; white noise only at lag 0, as blocks do not overlap), and r, the
+   cross-correlation of the wanted output with ā, r(τ) = Σ S_z |B| Δω cos(ω(τ − ℓ) − ∠B) with
+   B(ω) = −ω² times the block mean's response (for the rate, ω S_z and ∠B − π/2), for heave and
+   heave rate now (ℓ = 0) and ``smoother_lag`` s ago (the delayed outputs, ℓ = the lag: the
+   same R, two more right-hand sides). R also holds the measured acceleration above
+   ``omega_max`` (up to the block mean's first null), which is not heave to estimate, so the
+   filter does not amplify it. :func:`wiener_taps`.
+3. Every step, the four outputs are the weights applied to the block means ending at the
+   newest sample (a full-rate FIR of MEMORY/Δt taps, each block's weight spread over its
+   samples, computed as differences of a running sum: L + 1 reads instead of L·M multiplies)
+   of the acceleration less the window's mean (with the bias steps found, the ``offset``
+   output; the weights sum to zero, so it changes no output).
+
+Bias steps. The output has no gain at zero frequency, so a constant bias never reaches it, but a
+bias *step* in mid-run would stay in the spectrum window as a 1/ω² density, taken for sea at low
+frequency until it left the window 20 minutes later (on Hs 2.5 / Tp 9 after 0.5 m/s²: 59 cm RMS in
+the second minute, 2.8 cm at 5-10 minutes; README). So every :data:`STEP_CHECK` s the window is
+searched for a step (:func:`~.bias_step.find_bias_step`: the kink it puts into the integrated
+acceleration); one found is taken out of the window and of the filter's input from its first
+sample on, and of every sample to come (the ``offset`` output includes it), and its size is
+estimated again at every check for :data:`STEP_REFINE_AGE` s as the record after it grows. The
+heave is then the heave of the run without the step (test). A warning is logged for each step.
+
+Measured (a scan, 2026-11-23, seed 3, 30 min after 2 min, real-time heave RMS error at the IMU
+[cm]; band observer → this, causal bound): Hs 4 / Tp 6 0.49 → 0.36 (0.35); Hs 2.5 / Tp 9
+1.03 → 0.87 (0.80); Hs 4 / Tp 12 2.31 → 2.00 (1.87); Hs 4 / Tp 14 2.96 → 2.64 (2.42), figures
+of the offline design from one 600 s spectrum; the estimator's own figures are in the README.
+
+Bad samples (NaN, Inf, absurd values, :func:`~.heave.read_sample`) enter the filter as the
+window's mean (zero acceleration: the estimate decays to zero over the memory rather than
+drifting), ``valid`` is false and a warning is logged. A change of step size restarts.
+Not a library filter: scipy designs FIR filters from magnitude specifications
+(``firwin2``, ``remez``), not least-squares Wiener filters from cross-spectra; the solve is
+scipy's.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from scipy.linalg import solve_toeplitz
+
+from .common import HeaveObserverParams, HeaveResult, SilentLog, backward_rate, point_heave, read_and_start, \
+    vertical_acceleration
+from .bias_step import BiasStep, find_bias_step
+from .spectrum import Spectrum, acceleration_spectrum, band_integral, find_modes
+
+log = logging.getLogger(__name__)
+
+#: Tap spacing of the Wiener filter: the length of the acceleration block means it weighs [s].
+BLOCK = 0.4
+#: How far back the Wiener filter looks [s] (the causal bound changes by < 2 % from 120 to
+#: 240 s, :func:`~marinefmu.papers.paper003.causal_bound`).
+MEMORY = 180.0
+#: Width of the moving average over the acceleration spectrum, relative to the frequency
+#: (at least one bin). Measured (a scan, 2026-11-23, seed 3, real-time heave RMS error at the
+#: IMU [cm]), Hs 4 / Tp 12 and Hs 4 / Tp 14: relative 0.05 / 0.1 / 0.2: 2.16 / 2.11 / 2.15 and
+#: 2.86 / 2.77 / 2.74; a fixed 0.025 / 0.05 / 0.1 / 0.2 rad/s: 2.24 / 2.15 / 2.23 / 2.70 and
+#: 2.97 / 2.80 / 2.82 / 3.24. Relative 0.1 is also no worse on the other seas of the checks.
+SMOOTHING = 0.1
+#: Interval of the search for a bias step in the buffered window (:mod:`.bias_step`) [s].
+STEP_CHECK = 1.0
+#: A step found is estimated again at every check until it is this old [s] …
+STEP_REFINE_AGE = 600.0
+#: … and the difference taken out when it reaches this [m/s²].
+STEP_REFINE_MIN = 1e-4
+
+
+def excess_acceleration(spectrum: Spectrum, acc_noise: float, offset_noise: float,
+                        smoothing: float = SMOOTHING) -> np.ndarray:
+    """The acceleration density above the sensor's noise, max(⟨S_ä − S_n⟩, 0)
+    [(m/s²)²/(rad/s)], at the spectrum's frequencies (arguments as :func:`sea_heave_density`)."""
+    omega = spectrum.omega
+    noise = (acc_noise**2 + offset_noise**2 / omega**2) / math.pi
+    half = np.maximum(0.5 * smoothing * omega, 0.5 * (omega[1] - omega[0]))
+    excess = band_integral(omega, spectrum.acc_density - noise, omega - half, omega + half) / (2.0 * half)
+    return np.maximum(excess, 0.0)
+
+
+def sea_heave_density(spectrum: Spectrum, acc_noise: float, offset_noise: float, omega_min: float,
+                      omega_max: float, smoothing: float = SMOOTHING) -> np.ndarray:
+    """Step 1: the sea's heave spectrum S_z [m²/(rad/s)] at the spectrum's frequencies.
+
+    Parameters
+    ----------
+    spectrum : Spectrum
+        From :func:`~.wave_peaks.acceleration_spectrum` (one-sided density per rad/s).
+    acc_noise : float
+        Accelerometer white-noise density N [m/s²/√Hz].
+    offset_noise : float
+        Bias random-walk density q [m/s²/√s].
+    omega_min, omega_max : float
+        Band of the sea [rad/s].
+    smoothing : float
+        Width of the moving average over the excess density, relative to the frequency (at
+        least one bin; :data:`SMOOTHING`).
+    """
+    omega = spectrum.omega
+    sea = excess_acceleration(spectrum, acc_noise, offset_noise, smoothing) / omega**4
+    sea[(omega < omega_min) | (omega > omega_max)] = 0.0
+    return sea
+
+
+def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: int, taps: int, lag: float,
+                acc_noise: float, offset_noise: float, unwanted: np.ndarray | None = None) -> np.ndarray:
+    """Step 2: the weights of the four outputs on the block means.
+
+    Parameters
+    ----------
+    omega, heave_density : numpy.ndarray
+        (K,) uniform frequencies [rad/s] and the sea's heave spectrum on them [m²/(rad/s)]
+        (:func:`sea_heave_density`); interpolated onto a grid fine enough that the modelled
+        correlations repeat only after four times the memory (a short window's bins, 2π/T
+        apart, would make them repeat after T, within the memory, and the design singular).
+    dt : float
+        Sample interval [s].
+    block : int
+        Samples per block mean M.
+    taps : int
+        Number of blocks L.
+    lag : float
+        Delay of the delayed outputs [s].
+    acc_noise, offset_noise : float
+        As :func:`sea_heave_density`.
+    unwanted : numpy.ndarray, optional
+        (K,) acceleration density on ``omega`` that is not heave to estimate [(m/s²)²/(rad/s)]:
+        the measured excess above ``omega_max`` (short waves a buoy follows, vibration). It
+        enters the autocorrelation only, up to 2π/(M·Δt), the block mean's first null (beyond
+        it the block mean passes ≤ 5 % of the power), so the filter does not amplify it:
+        without it, a wind sea reaching 6.3 rad/s with ``omega_max`` 6 met a gain of 165 at
+        6.5 rad/s and its heave was 0.9 m wrong on a 0.45 m std (test).
+
+    Returns
+    -------
+    numpy.ndarray
+        (4, L) weights of the block means of acceleration [m/s²], newest block first (block j
+        is the samples j·M … j·M + M − 1 steps old), of heave [m], heave rate [m/s], and both
+        ``lag`` s ago.
+    """
+    memory = taps * block * dt
+    top = float(np.max(omega[heave_density > 0.0], initial=omega[0]))
+    if unwanted is not None:
+        first_null = 2.0 * math.pi / (block * dt)
+        top = max(top, min(float(np.max(omega[unwanted > 0.0], initial=omega[0])), first_null))
+    d_omega = min(omega[1] - omega[0], math.pi / (2.0 * memory))    # correlations periodic in 4× the memory
+    w = np.arange(omega[0], top + d_omega, d_omega)
+    s_z = np.interp(w, omega, heave_density)
+    extra = np.zeros_like(w) if unwanted is None else np.interp(w, omega, unwanted)
+    mean_response = np.exp(-1j * np.outer(w, np.arange(block) * dt)).mean(axis=1)
+    b = -(w**2) * mean_response
+    tau = np.arange(taps) * block * dt
+    acc_density = np.abs(mean_response) ** 2 * (s_z * w**4 + extra + offset_noise**2 / (math.pi * w**2))
+    auto = (acc_density * d_omega) @ np.cos(np.outer(w, tau))
+    auto[0] += acc_noise**2 / (block * dt)
+    cross = []
+    for delay in (0.0, lag):
+        phase = np.outer(w, tau - delay) - np.angle(b)[:, None]
+        cross.append((s_z * np.abs(b) * d_omega) @ np.cos(phase))
+        cross.append((s_z * w * np.abs(b) * d_omega) @ np.cos(phase + 0.5 * math.pi))
+    solved = solve_toeplitz(auto, np.column_stack([*cross, np.ones(taps)]))
+    weights, ones = solved[:, :4], solved[:, 4]                         # R⁻¹r (L, 4), R⁻¹1
+    weights -= np.outer(ones, weights.sum(axis=0) / ones.sum())         # no gain at zero frequency
+    return weights.T
+
+
+class WienerHeave:
+    """Heave at the IMU and at a point by the spectrum's causal Wiener filter (module docstring).
+
+    Parameters
+    ----------
+    params : HeaveObserverParams, optional
+        Uses ``window``, ``window_max``, ``peak_interval``, ``omega_min``, ``omega_max``,
+        ``acc_noise``, ``offset_noise``, ``smoother_lag``, ``vertical``, ``transfer`` and
+        ``point``; ``max_modes``, ``min_separation`` and ``min_relative`` for the peaks of the
+        sea's heave spectrum reported as ``modes`` and ``omega`` (the filter has no modes;
+        :func:`~.wave_peaks.find_modes` on √S_z: swell and wind sea). ``model`` is ignored.
+    quiet : bool
+        Log nothing.
+
+    Examples
+    --------
+    >>> wh = WienerHeave(HeaveObserverParams(model="wiener", window=60.0))
+    >>> r = wh.step((0.0, 0.0, -9.80665), 0.0, 0.0, 0.1)
+    >>> r.valid      # no spectrum before the first window is full
+    False
+    """
+
+    def __init__(self, params: HeaveObserverParams | None = None, *, quiet: bool = False) -> None:
+        self.params = params or HeaveObserverParams(model="wiener")
+        self.log: Any = SilentLog() if quiet else log
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the initial state."""
+        self.dt: float | None = None
+        self.k = 0
+        self.next_detect = 0
+        self.spectrum_buf = np.zeros(0)      # ring of window_max samples of a_v
+        self.sum_buf = np.zeros(0)           # running sum of a_v, twice over (contiguous reads)
+        self.angle_buf = np.zeros((0, 2))    # ring of roll, pitch for the delayed point
+        self.taps: np.ndarray | None = None  # (4, L) weights of block sums, newest block first
+        self.tap_sums = np.zeros(4)          # the taps' sums over the samples
+        self.total = 0.0                     # the running sum at the newest sample
+        self.mean = 0.0
+        self.level = 0.0                     # bias steps found and taken out of the buffers [m/s²]
+        self.step_at: int | None = None      # sample index of the last step found (refined as it ages)
+        self.peak_period = 0.0
+        self.peaks: tuple[float, ...] = ()   # frequencies of the sea's spectral peaks [rad/s]
+
+    def start(self, dt: float) -> None:
+        p = self.params
+        self.dt = dt
+        self.block = max(1, int(round(BLOCK / dt)))
+        self.blocks = max(2, int(round(MEMORY / (self.block * dt))))
+        self.n_fir = self.block * self.blocks
+        self.lag_steps = int(round(p.smoother_lag / dt))
+        self.spectrum_buf = np.zeros(max(int(round(p.window / dt)), int(round(p.window_max / dt))))
+        self.sum_buf = np.zeros(2 * (self.n_fir + 1))
+        self.angle_buf = np.zeros((self.lag_steps + 3, 2))
+        self.next_detect = int(round(p.window / dt))
+        self.check_every = max(1, int(round(STEP_CHECK / dt)))
+
+    @property
+    def delay(self) -> float:
+        """Lag of the delayed outputs [s]."""
+        return 0.0 if self.dt is None else self.lag_steps * self.dt
+
+    def _window(self) -> np.ndarray:
+        """The buffered accelerations (at most ``window_max`` s), oldest first."""
+        n = len(self.spectrum_buf)
+        return np.roll(self.spectrum_buf, -(self.k % n))[-min(self.k, n):]
+
+    def _angles(self, age: int, count: int) -> list[tuple[float, float]]:
+        """``count`` (roll, pitch) samples [rad], oldest first, ending ``age`` samples before the
+        newest stored one."""
+        n = len(self.angle_buf)
+        return [tuple(self.angle_buf[(self.k - 1 - age - j) % n]) for j in range(count - 1, -1, -1)]
+
+    def _design(self) -> None:
+        """Steps 1-2 on the window: new taps and mean."""
+        p = self.params
+        self.next_detect = self.k + max(1, int(round(p.peak_interval / self.dt)))
+        win = self._window()
+        self.sum_buf -= self.total          # keep the running sum near zero: its differences are unchanged
+        self.total = 0.0
+        spectrum = acceleration_spectrum(win, self.dt)
+        excess = excess_acceleration(spectrum, p.acc_noise, p.offset_noise, SMOOTHING)
+        sea = np.where((spectrum.omega >= p.omega_min) & (spectrum.omega <= p.omega_max), excess / spectrum.omega**4,
+                       0.0)
+        if not np.any(sea > 0.0):
+            self.log.warning("wiener heave: no sea above the noise in [%g, %g] rad/s; filter unchanged",
+                             p.omega_min, p.omega_max)
+            return
+        self.peak_period = 2.0 * math.pi / float(spectrum.omega[np.argmax(sea)])
+        found = find_modes(replace(spectrum, position_amplitude=np.sqrt(sea)), p.omega_min, p.omega_max,
+                           p.max_modes, p.min_separation, p.min_relative)
+        self.peaks = tuple(float(w) for w in found.omega)
+        blocks = min(self.blocks, self.k // self.block)           # no further back than the data
+        above = np.where(spectrum.omega > p.omega_max, excess, 0.0)
+        self.taps = np.ascontiguousarray(wiener_taps(spectrum.omega, sea, self.dt, self.block, blocks, self.delay,
+                                                     p.acc_noise, p.offset_noise, above) / self.block)  # as restored
+        self.tap_sums = self.taps.sum(axis=1) * self.block
+        self.mean = float(win.mean())
+
+    def _check_bias_step(self) -> None:
+        """Look for a bias step in the window (:func:`~.bias_step.find_bias_step`) and take it
+        out; else estimate the last one's size again on the longer record since it (its first
+        estimate, made early, errs by about √2 σ_v / its age) and take out the difference."""
+        win = self._window()
+        first = self.k - len(win)
+        found = find_bias_step(win, self.dt)
+        if found is not None:
+            self._relevel(found, first)
+            self.step_at = first + found.index
+            self.log.warning("wiener heave: a bias step of %+.4f m/s² at t = %.1f s (%.0f s ago, z = %.1f) found "
+                             "and taken out", found.size, self.step_at * self.dt, (self.k - self.step_at) * self.dt,
+                             found.z)
+        elif self.step_at is not None:
+            if self.step_at <= first or (self.k - self.step_at) * self.dt > STEP_REFINE_AGE:
+                self.step_at = None
+                return
+            again = find_bias_step(win, self.dt, at=self.step_at - first)
+            if again is not None and abs(again.size) >= STEP_REFINE_MIN:
+                self._relevel(again, first)
+
+    def _relevel(self, found: BiasStep, first: int) -> None:
+        """Take a bias step out of the buffers, from its first sample on (``first``: the
+        absolute index of the window's oldest sample), and out of every sample to come."""
+        start, size = first + found.index, found.size
+        n = len(self.spectrum_buf)
+        self.spectrum_buf[np.arange(max(start, self.k - n), self.k) % n] -= size
+        n_sum = self.n_fir + 1
+        stored = np.arange(max(start, self.k - n_sum), self.k)
+        for offset in (0, n_sum):
+            self.sum_buf[stored % n_sum + offset] -= size * (stored - start + 1)
+        self.total -= size * (self.k - start)
+        self.level += size
+
+    def response(self, omega: Any) -> np.ndarray | None:
+        """Heave response H(e^{jωΔt}) of the current filter: the real-time heave estimate of a
+        noise-free sinusoidal heave at ω [rad/s] is H(ω) times the truth (the filter sees −ω²
+        times the heave). None before the first design."""
+        if self.taps is None:
+            return None
+        w = np.asarray(omega, dtype=float)
+        flat = w.reshape(-1, 1)
+        blocks = np.exp(-1j * flat * (np.arange(self.taps.shape[1]) * self.block * self.dt)) @ self.taps[0]
+        within = np.exp(-1j * flat * (np.arange(self.block) * self.dt)).sum(axis=1)
+        return (-(w**2) * (blocks * within).reshape(w.shape))
+
+    def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
+        """Process one sample (arguments as :meth:`.HeaveObserver.step`)."""
+        p = self.params
+        f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
+        if warning is None:
+            a_v = vertical_acceleration(f, roll, pitch, p.vertical) - self.level
+        else:
+            self.log.warning("wiener heave: %s; the window's mean acceleration used", warning)
+            a_v = self.mean
+            roll, pitch = self._angles(0, 1)[0] if self.k else (0.0, 0.0)      # the last good ones
+        self.spectrum_buf[self.k % len(self.spectrum_buf)] = a_v
+        n_sum = self.n_fir + 1
+        i = self.k % n_sum
+        self.total += a_v
+        self.sum_buf[i] = self.sum_buf[i + n_sum] = self.total
+        self.angle_buf[self.k % len(self.angle_buf)] = (roll, pitch)
+        self.k += 1
+        if self.k % self.check_every == 0:
+            self._check_bias_step()
+        if self.k >= self.next_detect:
+            self._design()
+        if self.taps is None:
+            return HeaveResult(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, self.delay, 0.0, 0, 0.0, (), False, False,
+                               warning)
+        nodes = self.sum_buf[i + n_sum:i + n_sum - self.taps.shape[1] * self.block - 1:-self.block]
+        heave, rate, d_heave, d_rate = self.taps @ (nodes[:-1] - nodes[1:]) - self.mean * self.tap_sums
+        rates = backward_rate(self._angles(0, min(3, self.k)), self.dt)
+        ph, pr = point_heave(heave, rate, p.point, roll, pitch, *rates, p.transfer)
+        old = self._angles(self.lag_steps, 3)
+        d_point, _ = point_heave(d_heave, d_rate, p.point, *old[-1], *backward_rate(old, self.dt), p.transfer)
+        delayed_valid = self.k * self.dt >= p.window + self.delay
+        return HeaveResult(float(heave), float(rate), ph, pr, float(d_heave), float(d_rate), d_point, self.delay,
+                           self.level + self.mean, len(self.peaks), self.peak_period, self.peaks, warning is None,
+                           delayed_valid, warning)
+
+    def get_state(self) -> dict:
+        """JSON-serialisable state."""
+        def arr(v: Any) -> Any:
+            return None if v is None else np.asarray(v).tolist()
+        return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect, "spectrum_buf": arr(self.spectrum_buf),
+                "sum_buf": arr(self.sum_buf), "total": self.total, "angle_buf": arr(self.angle_buf),
+                "taps": arr(self.taps),
+                "mean": self.mean, "level": self.level, "step_at": self.step_at, "peak_period": self.peak_period,
+                "peaks": list(self.peaks)}
+
+    def set_state(self, s: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.reset()
+        if s["dt"] is None:
+            return
+        self.start(float(s["dt"]))
+        self.k, self.next_detect = int(s["k"]), int(s["next_detect"])
+        self.spectrum_buf = np.array(s["spectrum_buf"], dtype=float)
+        self.sum_buf, self.total = np.array(s["sum_buf"], dtype=float), float(s["total"])
+        self.angle_buf = np.array(s["angle_buf"], dtype=float).reshape(-1, 2)
+        if s["taps"] is not None:
+            self.taps = np.array(s["taps"], dtype=float)
+            self.tap_sums = self.taps.sum(axis=1) * self.block
+        self.mean, self.level, self.peak_period = float(s["mean"]), float(s["level"]), float(s["peak_period"])
+        self.step_at = None if s["step_at"] is None else int(s["step_at"])
+        self.peaks = tuple(float(w) for w in s["peaks"])

@@ -1,0 +1,268 @@
+"""Paper 000's reconstruction run online on a sliding window (the DisplacementReconstructor).
+
+Every ``hop`` seconds, once ``window`` seconds of samples are in, the tilt-corrected
+acceleration of the last window is decomposed (:func:`~.reconstruction.decompose`, one call per
+axis), screened, and kept as a continuous-time model. Between refits each step evaluates that
+model:
+
+- the **latest** estimate at the current time t (the model extrapolated at most ``hop``
+  seconds past the end of its window: ``latency`` says how far);
+- the **centred** estimate at t − window/2 (inside the window, where the fit is best), with
+  that fixed ``delay``.
+
+The COG transfer (eq. 32) subtracts R_nb(t) l minus its straight-line trend over the window,
+the online counterpart of :func:`~.reconstruction.lever_arm_offset`'s high-pass.
+
+Bad samples (NaN, Inf, |f| > 200 m/s², |roll| or |pitch| > 80°) are replaced in the window by
+the last good sample; ``valid`` is False while more than ``max_bad_fraction`` of the fitted
+window was replaced, on the bad step itself, and until the first window is full.
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import check_choice, check_range, check_vector
+from ...frames import G, rot_nb
+from ..samples import angles_beyond_limit, force_beyond_limit
+from .decomposition import (
+    TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, lowpass_decimate,
+    tilt_correct,
+)
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class DisplacementReconstructorParams:
+    """Parameters of :class:`DisplacementReconstructor` (FMU names in brackets).
+
+    Parameters
+    ----------
+    window : float
+        Window length [s], ≥ 2/cutoff and ≤ 3600. [``window``]
+    hop : float
+        Refit interval [s], (0, window]. [``hop``]
+    cutoff : float
+        Screening frequency F [Hz] (eq. 25). [``cutoff``]
+    max_components : int
+        Most components per axis, 1 … 2000. [``max_components``]
+    lever_arm : tuple of float
+        Sensor position relative to the COG, body frame [m]. [``lever_arm.{x,y,z}``]
+    fmax : float
+        Highest motion frequency [Hz] (decimation). [``fmax``]
+    tilt : str
+        ``"exact"`` or ``"small_angle"`` (eq. 15). [``tilt``]
+    max_damping : float
+        Screen components with |damping ratio| above this, (0, 1]; 1 keeps all. [``max_damping``]
+    sc_tol : float
+        Relative residual stopping threshold, (0, 1). [``sc_tol``]
+    max_bad_fraction : float
+        Largest fraction of replaced samples in a window for a valid estimate, [0, 0.5].
+    """
+
+    window: float = 200.0
+    hop: float = 10.0
+    cutoff: float = 0.03
+    max_components: int = 60
+    lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    fmax: float = 0.5
+    tilt: str = "exact"
+    max_damping: float = 0.8
+    sc_tol: float = 1e-5
+    max_bad_fraction: float = 0.01
+
+    def validate(self, dt: float) -> None:
+        """Check the parameters against the sample interval ``dt`` [s]."""
+        check_reconstruction_params(dt, self.cutoff, self.max_components, self.fmax, None)
+        check_range("window", self.window, lo=2.0 / self.cutoff, hi=3600.0, unit="s")
+        check_range("hop", self.hop, lo=0.0, hi=self.window, lo_open=True, unit="s")
+        check_vector("lever_arm", self.lever_arm, unit="m")
+        check_choice("tilt", self.tilt, TILT_CHOICES)
+        check_range("max_damping", self.max_damping, lo=0.0, hi=1.0, lo_open=True)
+        check_range("sc_tol", self.sc_tol, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
+        check_range("max_bad_fraction", self.max_bad_fraction, lo=0.0, hi=0.5)
+
+
+@dataclass(frozen=True)
+class DisplacementReconstructorResult:
+    """One step's output: COG displacement/velocity [m, m/s, NED] at the current time and at
+    t − delay, ``delay`` [s], ``latency`` [s] (time past the end of the fitted window),
+    ``valid`` and the rejection ``warning``, if any."""
+
+    disp: tuple[float, float, float]
+    vel: tuple[float, float, float]
+    centred_disp: tuple[float, float, float]
+    centred_vel: tuple[float, float, float]
+    delay: float
+    latency: float
+    valid: bool
+    warning: str | None = None
+
+
+class DisplacementReconstructor:
+    """Online displacement reconstruction (module docstring).
+
+    Parameters
+    ----------
+    params : DisplacementReconstructorParams
+        Parameters; checked against ``dt`` at the first :meth:`step` (or call
+        :meth:`configure`).
+    """
+
+    def __init__(self, params: DisplacementReconstructorParams | None = None, dt: float | None = None) -> None:
+        self.params = params or DisplacementReconstructorParams()
+        self.dt: float | None = None
+        if dt is not None:
+            self.configure(dt)
+
+    def configure(self, dt: float) -> None:
+        """Fix the sample interval [s], validate and allocate the window buffers."""
+        self.params.validate(dt)
+        p = self.params
+        self.dt = float(dt)
+        self.n_win = int(round(p.window / dt))
+        self.n_hop = max(1, int(round(p.hop / dt)))
+        self.q = decimation_factor(dt, p.fmax)
+        self.lever = np.array(p.lever_arm, dtype=float)
+        self.reset()
+
+    def reset(self) -> None:
+        """Empty the window."""
+        n = self.n_win
+        self.acc = np.zeros((n, 3))  # specific force [m/s², b]; tilt-corrected at each refit
+        self.euler = np.zeros((n, 3))
+        self.arm = np.zeros((n, 3))
+        self.bad = np.zeros(n, dtype=bool)
+        self.k = 0  # samples received
+        self.last_good: tuple[np.ndarray, np.ndarray] | None = None
+        self.models: list[tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None
+        self.t_start = 0.0  # time of the first sample of the fitted window (sample index based)
+        self.trend = np.zeros((2, 3))
+        self.fit_bad_fraction = 1.0
+
+    # ---- per step ------------------------------------------------------------------------------
+    def step(self, acc, euler, dt: float) -> DisplacementReconstructorResult:
+        """Add one sample and return the estimates.
+
+        Parameters
+        ----------
+        acc : array_like
+            (3,) specific force [m/s², b].
+        euler : array_like
+            (3,) roll, pitch, yaw [rad].
+        dt : float
+            Sample interval [s]; must stay the same.
+        """
+        if self.dt is None:
+            self.configure(dt)
+        acc = np.asarray(acc, dtype=float)
+        euler = np.asarray(euler, dtype=float)
+        warning = _check_sample(acc, euler)
+        if warning is not None:
+            log.warning("displacement reconstructor: %s; holding the last good sample", warning)
+            if self.last_good is None:
+                acc, euler = np.array([0.0, 0.0, -G]), np.zeros(3)
+            else:
+                acc, euler = self.last_good
+        else:
+            self.last_good = (acc, euler)
+        i = self.k % self.n_win
+        self.acc[i] = acc
+        self.euler[i] = euler
+        arm = rot_nb(*euler) @ self.lever
+        self.arm[i] = arm
+        self.bad[i] = warning is not None
+        self.k += 1
+        if self.k >= self.n_win and (self.k - self.n_win) % self.n_hop == 0:
+            self._refit()
+        return self._outputs(arm, warning)
+
+    def _ordered(self, buf: np.ndarray) -> np.ndarray:
+        i = self.k % self.n_win
+        return np.concatenate((buf[i:], buf[:i]))
+
+    def _refit(self) -> None:
+        p, dt = self.params, self.dt
+        acc = tilt_correct(self._ordered(self.acc), self._ordered(self.euler), p.tilt)
+        arm = self._ordered(self.arm)
+        self.t_start = (self.k - self.n_win) * dt
+        xd = lowpass_decimate(acc, self.q)
+        models = []
+        for axis in range(3):
+            d: Decomposition = decompose(xd[:, axis], dt * self.q, max_components=p.max_components, sc_tol=p.sc_tol,
+                                         cutoff=p.cutoff, fmax=p.fmax)
+            d.screen(p.cutoff, p.max_damping)
+            lam, gam = d.lam[d.kept], d.gamma[d.kept]
+            models.append((lam, gam / lam ** 2, gam / lam))
+        self.models = models
+        tt = np.arange(self.n_win) * dt
+        self.trend = np.polynomial.polynomial.polyfit(tt, arm, 1)  # (2, 3): offset, slope
+        self.fit_bad_fraction = float(self.bad.mean())
+
+    def _eval(self, t_rel: float) -> tuple[np.ndarray, np.ndarray]:
+        disp, vel = np.zeros(3), np.zeros(3)
+        for axis, (lam, c2, c1) in enumerate(self.models):
+            if len(lam):
+                e = np.exp(lam * t_rel)
+                disp[axis] = (e @ c2).real
+                vel[axis] = (e @ c1).real
+        return disp, vel
+
+    def _outputs(self, arm_now: np.ndarray, warning: str | None) -> DisplacementReconstructorResult:
+        p, dt = self.params, self.dt
+        delay = 0.5 * p.window
+        if self.models is None:
+            z = (0.0, 0.0, 0.0)
+            return DisplacementReconstructorResult(z, z, z, z, delay, 0.0, False, warning)
+        t_now = (self.k - 1) * dt - self.t_start  # time of the latest sample from the window start
+        latency = t_now - (self.n_win - 1) * dt
+        d_now, v_now = self._eval(t_now)
+        t_c = t_now - delay
+        d_c, v_c = self._eval(t_c)
+        k_c = int(round(self.t_start / dt)) + int(round(t_c / dt))  # absolute index of the centred sample
+        arm_c = self.arm[k_c % self.n_win]
+        off, slope = self.trend
+        d_now = d_now - (arm_now - (off + slope * t_now))
+        d_c = d_c - (arm_c - (off + slope * t_c))
+        valid = warning is None and self.fit_bad_fraction <= p.max_bad_fraction
+        return DisplacementReconstructorResult(tuple(d_now), tuple(v_now), tuple(d_c), tuple(v_c), delay, latency, valid, warning)
+
+    # ---- FMU state ---------------------------------------------------------------------------
+    def get_state(self) -> dict:
+        """JSON-serialisable state (window buffers and the fitted model)."""
+        if self.dt is None:
+            return {"dt": None}
+        models = None if self.models is None else [
+            [[lam.real.tolist(), lam.imag.tolist()], [c2.real.tolist(), c2.imag.tolist()], [c1.real.tolist(), c1.imag.tolist()]]
+            for lam, c2, c1 in self.models]
+        return {
+            "dt": self.dt, "acc": self.acc.tolist(), "euler": self.euler.tolist(), "arm": self.arm.tolist(), "bad": self.bad.tolist(), "k": self.k,
+            "last_good": None if self.last_good is None else [self.last_good[0].tolist(), self.last_good[1].tolist()],
+            "models": models, "t_start": self.t_start, "trend": self.trend.tolist(), "fit_bad_fraction": self.fit_bad_fraction,
+        }
+
+    def set_state(self, s: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        if s["dt"] is None:
+            self.dt = None
+            return
+        self.configure(s["dt"])
+        self.acc, self.euler = np.array(s["acc"]), np.array(s["euler"])
+        self.arm, self.bad = np.array(s["arm"]), np.array(s["bad"], dtype=bool)
+        self.k = int(s["k"])
+        self.last_good = None if s["last_good"] is None else (np.array(s["last_good"][0]), np.array(s["last_good"][1]))
+        self.models = None if s["models"] is None else [
+            tuple(np.array(re) + 1j * np.array(im) for re, im in m) for m in s["models"]]
+        self.t_start, self.trend = float(s["t_start"]), np.array(s["trend"])
+        self.fit_bad_fraction = float(s["fit_bad_fraction"])
+
+
+def _check_sample(acc: np.ndarray, euler: np.ndarray) -> str | None:
+    if acc.shape != (3,) or euler.shape != (3,):
+        return "sample of the wrong shape"
+    if not (np.all(np.isfinite(acc)) and np.all(np.isfinite(euler))):
+        return "non-finite acc or attitude sample"
+    return force_beyond_limit(acc) or angles_beyond_limit(euler)
