@@ -1,5 +1,5 @@
 """AhcController FMU: feedforward from the estimated crane-tip heave plus PI feedback on the
-wire length (issue 9). Thin adapter over ``marinefmu.ahc.controller``; never raises (see
+wire length. Thin adapter over ``marinefmu.ahc.controller``; never raises (see
 ``marinefmu.fmu.slave``)."""
 from pythonfmu import Fmi2Slave
 
@@ -16,7 +16,7 @@ if "AhcController" in globals():  # pythonfmu runs this file again for each inst
 else:
     class AhcController(Fmi2Slave):
         author = "marinefmu developers"
-        description = "Heave-compensation controller: heave feedforward + PI on the wire length (issue 9)"
+        description = "Heave-compensation controller: heave feedforward + PI on the wire length"
         version = __version__
         license = "MIT"
 

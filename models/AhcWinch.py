@@ -1,5 +1,5 @@
 """AhcWinch FMU: an active-heave-compensation winch at a crane tip with a load on an elastic
-wire (issue 9). Thin adapter over ``marinefmu.ahc.winch``; never raises (see
+wire. Thin adapter over ``marinefmu.ahc.winch``; never raises (see
 ``marinefmu.fmu.slave``). The load starts at rest below the crane tip of the first step."""
 from pythonfmu import Fmi2Slave
 
@@ -14,7 +14,7 @@ if "AhcWinch" in globals():  # pythonfmu runs this file again for each instance:
 else:
     class AhcWinch(Fmi2Slave):
         author = "marinefmu developers"
-        description = "Active-heave-compensation winch with a load on an elastic wire (issue 9)"
+        description = "Active-heave-compensation winch with a load on an elastic wire"
         version = __version__
         license = "MIT"
 

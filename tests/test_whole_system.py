@@ -4,7 +4,7 @@ HeaveObserver) written as an SSP package and run by the FMPy runner from it, and
 ``OspSystemStructure.xml`` and run by OSP libcosim; 10 simulated minutes, the same outputs."""
 import numpy as np
 import pytest
-from conftest import LibcosimBeside
+from tests.conftest import LibcosimBeside
 
 from marinefmu.cosim.libcosim import write_osp_system
 from marinefmu.cosim.ssp import read_ssp, write_ssp

@@ -1,4 +1,4 @@
-"""Frame conventions shared by the whole project (see DESIGN.md).
+"""Frame conventions shared by the whole project (see the design page).
 
 - World frame n: NED, origin at the mean position of the vessel reference point.
 - Body frame b: x forward, y starboard, z down (SNAME/Fossen).

@@ -1,7 +1,7 @@
 """Variable tables: the names, types, units and descriptions that an FMU exposes.
 
 Plain metadata with no FMI import, so that ``sea/`` and ``estimators/`` can declare their
-interface and ``cosim/`` can register it with pythonfmu and write units into the FMU.
+interface and ``fmu/`` can register it with pythonfmu and write units into the FMU.
 """
 from __future__ import annotations
 
@@ -57,7 +57,7 @@ def resolve(table: list[Variable], values: dict[str, Any], what: str) -> dict[st
     ParameterError
         For an unknown name, with the closest known name as a hint.
     """
-    from ..errors import ParameterError
+    from .errors import ParameterError
 
     known = {v.name: v for v in table}
     unknown = [k for k in values if k not in known]

@@ -1,4 +1,4 @@
-"""Active-heave-compensation controller (issue 9): feedforward from the estimated crane-tip
+"""Active-heave-compensation controller: feedforward from the estimated crane-tip
 heave plus PI feedback on the wire length.
 
 The load hangs at z_load = z_tip + L + e (NED, down positive; e the wire's stretch). To keep it

@@ -1,4 +1,4 @@
-"""The heave-compensation design loop of issue 9: identify, tune, verify, write back
+"""The heave-compensation design loop: identify, tune, verify, write back
 (``marinefmu design-ahc``).
 
 Given a system (scenario TOML) and the name of one AhcController in it, whose ``heave`` input
@@ -7,19 +7,21 @@ comes from an estimator and whose ``command`` drives an AhcWinch:
 1. **Identify**: co-simulate the estimator's upstream part of the system (every component the
    controller's ``heave`` input depends on) for ``identify`` s and identify the transfer H(ω)
    from the true crane-tip heave (the source of the winch's ``tip.d``, minus its mean) to
-   the estimate (:func:`~.ahc_design.identify_response`), on the span where the estimator is
-   ``valid``.
-2. **Tune**: the PI length loop for the winch's parameters (:func:`~.ahc_design.design`,
-   python-control, phase margin ``phase_margin``), then the feedforward gain fitted to the
-   identified responses (:func:`~.ahc_design.fit_feedforward`) with the co-simulation's
-   delays, and the residual it predicts.
+   the estimate (:func:`~marinefmu.ahc.design.identify_response`), on the span where the
+   estimator is ``valid``.
+2. **Tune**: the PI length loop for the winch's parameters
+   (:func:`~marinefmu.ahc.design.design`, python-control, phase margin ``phase_margin``), then
+   the feedforward gain fitted to the identified responses
+   (:func:`~marinefmu.ahc.design.fit_feedforward`) with the co-simulation's delays, and the
+   residual it predicts.
 3. **Verify**: co-simulate the estimator, the controller with the new gains and the winch for
-   ``verify`` s and score the load's residual heave (:func:`~.scoring.ahc_scores`).
+   ``verify`` s and score the load's residual heave
+   (:func:`~marinefmu.analysis.scoring.ahc_scores`).
 4. **Write**: Bode and step plots (PNG), and, when asked, the gains into the system file.
 
 A design that cannot be made (no crossover with the margin, an unstable loop) is refused by
-:func:`~.ahc_design.design` with the cause; a system without the pieces named above is refused
-here, naming what is missing.
+:func:`~marinefmu.ahc.design.design` with the cause; a system without the pieces named above
+is refused here, naming what is missing.
 """
 from __future__ import annotations
 
@@ -70,7 +72,7 @@ class DesignResult:
     predicted_pct, predicted_ideal_pct : float
         Predicted load heave / tip heave [%] with the estimator, and fed the truth.
     measured : dict
-        :func:`~.scoring.ahc_scores` of the verification run's winch.
+        :func:`~marinefmu.analysis.scoring.ahc_scores` of the verification run's winch.
     seconds : dict
         Wall time of each stage [s] (identify, tune, verify, plots).
     plots : list of Path
@@ -158,7 +160,7 @@ def identify(system: SystemDescription, parts: LoopParts, fmu_dir: str | Path, d
 def verify(system: SystemDescription, parts: LoopParts, ctrl: AhcControllerParams, fmu_dir: str | Path,
            duration: float, progress: bool = False) -> dict:
     """Stage 3: the estimator, the controller with ``ctrl``'s gains and the winch for
-    ``duration`` s; :func:`~.scoring.ahc_scores` of the winch."""
+    ``duration`` s; :func:`~marinefmu.analysis.scoring.ahc_scores` of the winch."""
     from ..cosim.system import SystemRunner
 
     keep = _upstream(system, {parts.winch})

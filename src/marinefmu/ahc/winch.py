@@ -1,6 +1,6 @@
-"""An active-heave-compensation winch at a crane tip with a load on an elastic wire (issue 9).
+"""An active-heave-compensation winch at a crane tip with a load on an elastic wire.
 
-Frames and signs (DESIGN.md): NED, z down. The crane tip moves with the vessel (VesselMotion's
+Frames and signs (the design page): NED, z down. The crane tip moves with the vessel (VesselMotion's
 ``truth.point.d`` and ``truth.point_vel.d``); the winch there pays out wire of length L
 (positive, more wire = load lower); the load hangs at z below the tip.
 
@@ -27,8 +27,9 @@ a 10 ms step they move by less than 1e-3 of their swing between the ends). Other
 classical Runge-Kutta 4 on substeps of at most ``max_substep`` s (the wire-load mode is
 ω = √(k/m), 10 rad/s for the defaults; RK4 at 2 ms resolves it to 1e-9); the clips are
 continuous functions of the state, the stroke stops are applied after each substep. The two
-agree to 2e-9 m where both apply (test); a step costs 23 µs instead of 65 µs with RK4 (measured
-2026-11-23), and a winch at sea spends almost all its steps in the linear regime. The RK4 is hand-written (not ``scipy.integrate.solve_ivp``):
+agree to 2e-9 m where both apply (test); the exact step costs about a third of an RK4 step, and a
+winch at sea spends almost all its steps in the linear regime. The RK4 is hand-written (not
+``scipy.integrate.solve_ivp``):
 a fixed-step co-simulation slave advances by a known step and must be cheap and deterministic.
 """
 from __future__ import annotations

@@ -1,11 +1,12 @@
-"""A one-page, self-contained HTML report of a whole-system run (issue 7, the main job).
+"""A one-page, self-contained HTML report of a whole-system run.
 
 :func:`write_report` takes a :class:`~.cosim.system.SystemRunner` result, the scenario and the
 scores of :func:`~.scoring.score`, and writes ``report.html`` with the figures embedded (PNG,
 base64): the system's diagram, truth against estimate for every estimator over the last minute,
 error traces over the run, the heave spectra, the centre-of-rotation convergence, and a table of
-each estimator's accuracy against its goal from the issue tracker. It is written for a reader
-who has not read the code: every figure and row says what it shows and in which unit.
+each estimator's accuracy against its goal, named by its source (:data:`GOALS`). It is written
+for a reader who has not read the code: every figure and row says what it shows and in which
+unit.
 """
 from __future__ import annotations
 
@@ -19,25 +20,25 @@ import numpy as np
 
 from ..cosim.ssp import SystemDescription
 
-#: Goals of the issue tracker per (FMU type, metric): (text, test on the scores of that
+#: Goals per (FMU type, metric): (text naming the goal's source, test on the scores of that
 #: component returning True when met). Metrics without a goal are reported without one.
 GOALS = {
-    ("AttitudeEstimator", "roll_deg"): ("≤ 0.02° (issue 3)", lambda s: s["roll_deg"] <= 0.02),
-    ("AttitudeEstimator", "pitch_deg"): ("≤ 0.02° (issue 3)", lambda s: s["pitch_deg"] <= 0.02),
-    ("HeaveObserver", "heave_cm"): ("≤ max(2 cm, 2.5 % of std) (issue 6)",
+    ("AttitudeEstimator", "roll_deg"): ("≤ 0.02° (project goal)", lambda s: s["roll_deg"] <= 0.02),
+    ("AttitudeEstimator", "pitch_deg"): ("≤ 0.02° (project goal)", lambda s: s["pitch_deg"] <= 0.02),
+    ("HeaveObserver", "heave_cm"): ("≤ max(2 cm, 2.5 % of std) (beyond the 5 cm / 5 % of commercial MRUs)",
                                     lambda s: s["heave_cm"] <= max(2.0, 0.025 * s["heave_std_cm"])),
-    ("HeaveObserver", "point_heave_cm"): ("≤ max(2 cm, 2.5 % of std) (issue 6)",
+    ("HeaveObserver", "point_heave_cm"): ("≤ max(2 cm, 2.5 % of std) (beyond the 5 cm / 5 % of commercial MRUs)",
                                           lambda s: s["point_heave_cm"] <= max(2.0, 0.025 * s["point_heave_std_cm"])),
-    **{("CentreOfRotation", f"cr_{a}_m"): ("≤ 0.1 m (issue 5)", lambda s, a=a: s[f"cr_{a}_m"] <= 0.1) for a in "xyz"},
-    **{("GnssAccFusion", f"pos_{a}_cm"): ("≤ 0.5 × raw GNSS (issue 4)",
+    **{("CentreOfRotation", f"cr_{a}_m"): ("≤ 0.1 m (project goal)", lambda s, a=a: s[f"cr_{a}_m"] <= 0.1) for a in "xyz"},
+    **{("GnssAccFusion", f"pos_{a}_cm"): ("≤ 0.5 × raw GNSS (project goal)",
                                          lambda s, a=a: None if f"raw_gnss_{a}_cm" not in s else s[f"pos_{a}_cm"] <= 0.5 * s[f"raw_gnss_{a}_cm"])
        for a in "ned"},
-    # issue 9: the goals are for the loop fed by a heave estimator (the winch that has vs_ideal/vs_classical)
-    ("AhcWinch", "residual_pct"): ("≤ 5 % when fed by the observer (issue 9)",
+    # the AHC goals are for the loop fed by a heave estimator (the winch that has vs_ideal/vs_classical)
+    ("AhcWinch", "residual_pct"): ("≤ 5 % when fed by the observer (project goal)",
                                    lambda s: None if "vs_ideal" not in s and "vs_classical" not in s else s["residual_pct"] <= 5.0),
-    ("AhcWinch", "vs_ideal"): ("≤ 1.5 (issue 9)", lambda s: s["vs_ideal"] <= 1.5),
-    ("AhcWinch", "vs_classical"): ("< 1 (issue 9)", lambda s: s["vs_classical"] < 1.0),
-    ("AhcWinch", "limited_pct"): ("≤ 1 % (issue 9)", lambda s: s["limited_pct"] <= 1.0),
+    ("AhcWinch", "vs_ideal"): ("≤ 1.5 (project goal)", lambda s: s["vs_ideal"] <= 1.5),
+    ("AhcWinch", "vs_classical"): ("< 1 (project goal)", lambda s: s["vs_classical"] < 1.0),
+    ("AhcWinch", "limited_pct"): ("≤ 1 % (project goal)", lambda s: s["limited_pct"] <= 1.0),
 }
 LABELS = {
     "roll_deg": "roll RMS error [deg]", "pitch_deg": "pitch RMS error [deg]",
@@ -222,7 +223,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
 
 def accuracy_rows(system: SystemDescription, scores: dict[str, dict[str, float]]) -> list[tuple[str, str, float, str, str]]:
     """(component, metric label, value, goal, status) rows of the accuracy table; status is
-    ``met``, ``not met`` or empty when the issue tracker gives no goal."""
+    ``met``, ``not met`` or empty for a metric without a goal."""
     kinds = {c.name: c.kind for c in system.components}
     rows = []
     for comp, metrics in scores.items():

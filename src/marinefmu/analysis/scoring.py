@@ -20,7 +20,7 @@ CentreOfRotation            ``cr_x_m``, ``cr_y_m``, ``cr_z_m`` (truth.cr, when t
                             the independent-rotation-centre mode and ``truth.cr.defined``)
 =========================  ====================================================================
 
-AhcWinch components (issue 9) are scored together, on one span: from ``settle`` s after the
+AhcWinch components are scored together, on one span: from ``settle`` s after the
 last AhcController of the system first reports ``valid`` (full compensation) to the end, so the
 winches of one run are compared on the same waves. Per winch: ``tip_heave_cm`` and
 ``load_heave_cm``, the standard deviations of the crane tip (the source of the winch's
@@ -88,8 +88,9 @@ def _span(result: np.ndarray, comp: str, settle: float) -> np.ndarray:
 
 def _raw_gnss(result: np.ndarray, comp, vessel: str, antennas: list[str], span: np.ndarray) -> dict[str, float]:
     """RMS error [cm] per NED axis of the COG fixed from the raw antenna positions alone
-    (:func:`~.estimators.antenna_attitude.antenna_attitude` with the fusion's lever arms) at the
-    GNSS epochs in ``span``: the yardstick of issue 4's goal, fused error ≤ 0.5 × raw."""
+    (:func:`~marinefmu.estimators.gnss_fusion.antenna_attitude.antenna_attitude` with the
+    fusion's lever arms) at the GNSS epochs in ``span``: the yardstick of the project goal for
+    the fusion, fused error ≤ 0.5 × raw."""
     from ..estimators.gnss_fusion.antenna_attitude import DEFAULT_ANTENNAS, antenna_attitude
 
     arms = np.array([[float(comp.parameters.get(f"ant{i + 1}.{a}", DEFAULT_ANTENNAS[i][j])) for j, a in enumerate("xyz")]

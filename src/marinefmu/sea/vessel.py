@@ -1,6 +1,6 @@
 """Linear 6-DOF wave-frequency vessel response through RAOs.
 
-RAO convention (our frames, DESIGN.md): for a regular wave of amplitude a, elevation
+RAO convention (our frames, the design page): for a regular wave of amplitude a, elevation
 η = a cos(ω_e t + ε) at the origin of the frame moving with the vessel (positive up), the
 response of DOF j is x_j(t) = Re(RAO_j(ω, β) · a · e^{i(ω_e t + ε)}). DOFs are surge, sway,
 heave (NED, heave positive down) [m/m] and roll, pitch, yaw (ZYX Euler, FRD body) [rad/m].

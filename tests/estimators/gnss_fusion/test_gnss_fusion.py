@@ -122,7 +122,7 @@ def test_a_held_attitude_in_a_large_roll_keeps_its_fixes():
     paper-001 set-up: roll 4.6° RMS), 1 Hz GNSS, 300 s. The held attitude turns by centiradians
     before the next fix and the accelerometer point's innovations grow with it. The gate weighs
     them against the error covariance's innovation variance, which models that rotation
-    (``fusion_error``): every fix accepted, measured COG RMS 0.91 / 10.3 / 6.0 cm N / E / D
+    (``estimators.gnss_fusion.error_model``): every fix accepted, measured COG RMS 0.91 / 10.3 / 6.0 cm N / E / D
     after 100 s (bound 20 cm), and ``pos_std`` not over-confident (error / ``pos_std`` RMS
     0.91 / 0.77 / 0.88, bound 1.3). Against the filter's own covariance alone the gate
     rejected 58 of the 301 fixes and the output drifted to 8 m RMS east."""
@@ -245,7 +245,7 @@ def test_a_20_m_jump_is_gated_out():
 def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 180 s spectrum window and 120 s
     of fixes before it). Real time with ``coast="band"`` (default, the GNSS-aided band observer
-    of estimators.aided_band with its tilt states and the wave-tilt band, on its own slower
+    of estimators.gnss_fusion.aided_band with its tilt states and the wave-tilt band, on its own slower
     attitude): measured max per axis 1.8-4.3 / 4.7-6.3 / 2.1-3.0 cm north / east / down over
     seeds 1-3 (session 33; east 4.8-7.4 cm without the wave-tilt band, 5.1-8.3 cm before the
     gyro's angle random walk in the tilt states; the line coast before them: east 8.4 / 3.8 /

@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import LibcosimBeside
+from tests.conftest import LibcosimBeside
 
 from marinefmu.ahc.winch import AhcWinchParams
 from marinefmu.ahc.design import design, fit_feedforward, identify_response, predicted_residual
@@ -193,7 +193,7 @@ def test_the_copyable_example_designs_and_writes(tmp_path, fmu_dir):
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "examples" / "ahc_design_loop.py"
+    path = Path(__file__).resolve().parents[2] / "examples" / "ahc_design_loop.py"
     spec = importlib.util.spec_from_file_location("ahc_design_loop_example", path)
     example = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(example)

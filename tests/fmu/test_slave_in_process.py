@@ -6,7 +6,7 @@ import numpy as np
 
 from marinefmu.sea.motion_model import REAL_OUTPUTS, VesselMotion, VesselMotionParams
 
-SCRIPT = Path(__file__).resolve().parents[1] / "models" / "VesselMotion.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "models" / "VesselMotion.py"
 
 
 def slave_class():

@@ -2,7 +2,7 @@
 accelerometer sample, NaN antenna coordinates and new-fix detection without gnss.new."""
 import numpy as np
 import pytest
-from conftest import DT, Driver
+from tests.conftest import DT, Driver
 
 from marinefmu.fmu.tables import fusion_params
 from marinefmu.estimators.gnss_fusion.filter import GnssAccFusion

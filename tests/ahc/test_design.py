@@ -44,7 +44,7 @@ def test_impossible_designs_are_refused_with_the_cause():
 @pytest.mark.fmu
 def test_designed_gains_hold_the_load_in_co_simulation(fmu_dir):
     """The designed gains (k_p 4.9 /s, k_i 2.2 /s², crossover 4.5 rad/s, phase margin 60°) in
-    the truth-fed loop of tests/test_ahc_controller.py: the load moves 1.37 % of the tip's heave
+    the truth-fed loop of tests/ahc/test_controller.py: the load moves 1.37 % of the tip's heave
     (measured; 2.0 % with the hand-picked k_p 3 /s)."""
     from marinefmu.cosim.ssp import Component, Connection, SystemDescription
     from marinefmu.cosim.system import SystemRunner

@@ -188,7 +188,7 @@ def test_build_skips_unchanged_models_and_rebuilds_a_changed_one(tmp_path):
 
     models = tmp_path / "models"
     models.mkdir()
-    shutil.copy(Path(__file__).parent / "models" / "MfTestRelay.py", models)
+    shutil.copy(Path(__file__).resolve().parents[1] / "models" / "MfTestRelay.py", models)
     dest = tmp_path / "fmus"
     assert [r.rebuilt for r in build_all(models, dest, verbose=False)] == [True]
     stamp = (dest / "MfTestRelay.fmu").stat().st_mtime_ns
@@ -253,7 +253,7 @@ def test_two_builders_of_one_folder_take_turns(tmp_path):
 
     models = tmp_path / "models"
     models.mkdir()
-    shutil.copy(Path(__file__).parent / "models" / "MfTestRelay.py", models)
+    shutil.copy(Path(__file__).resolve().parents[1] / "models" / "MfTestRelay.py", models)
     dest = tmp_path / "fmus"
     code = ("import sys\nfrom pathlib import Path\nfrom marinefmu.fmu.build import build_all\n"
             f"print([r.rebuilt for r in build_all(Path({str(models)!r}), Path({str(dest)!r}), verbose=False)])\n")

@@ -3,7 +3,7 @@ parameter refusal) run by FMPy equal the in-process
 estimators bit for bit, refuse bad parameters by name, and coast over a NaN input."""
 import numpy as np
 import pytest
-from conftest import Driver
+from tests.conftest import Driver
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu

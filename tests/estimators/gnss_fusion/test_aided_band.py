@@ -1,4 +1,4 @@
-"""The GNSS-aided band observer of the dropout coast (estimators.aided_band, estimators.wave_coast)."""
+"""The GNSS-aided band observer of the dropout coast (estimators.gnss_fusion.aided_band and .wave_coast)."""
 import json
 import math
 

@@ -1,4 +1,4 @@
-"""The bench's memory figure for the whole system (bench_system.peak_rss_mb): a worker reports
+"""The bench's memory figure for the whole system (bench.system.peak_rss_mb): a worker reports
 its own peak, not the peak of the process that started it."""
 import subprocess
 import sys

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import DT, Driver
+from tests.conftest import DT, Driver
 
 from marinefmu.fmu.tables import heave_params
 from marinefmu.estimators.heave.bank import OscillatorBankHeave

@@ -1,4 +1,4 @@
-"""The linear bound of a GNSS gap (examples.gap_bound): its features are causal."""
+"""The linear bound of a GNSS gap (papers.gap_bound): its features are causal."""
 import numpy as np
 import pytest
 
