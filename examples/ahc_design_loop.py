@@ -25,7 +25,7 @@ from pathlib import Path
 
 from marinefmu.ahc.design import design, fit_feedforward, predicted_residual
 from marinefmu.ahc.loop import GAINS, find_loop, identify, verify, write_gains
-from marinefmu.fmu.ahc_tables import controller_params, winch_params
+from marinefmu.fmu.tables import controller_params, winch_params
 from marinefmu.fmu.build import build_all, repo_root
 from marinefmu.cosim.scenarios import load_scenario
 

@@ -24,10 +24,12 @@ from __future__ import annotations
 import difflib
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import SystemError_
-from .ssp import Component, SystemDescription
+
+if TYPE_CHECKING:  # annotations only: ssp imports this module to check what it reads
+    from .ssp import Component, SystemDescription
 
 
 def describe(comp: Component, base_dir: str | Path) -> Any:

@@ -118,7 +118,7 @@ def test_the_joint_covariance_tells_how_position_and_attitude_errors_go_together
     """The output's east error and the roll error ε_N (true minus estimated attitude about north)
     are correlated: an attitude error moves the acceleration by g·ε and the fix's accelerometer
     point by ε over the arm, and the filter follows both. The joint covariance (module docstring
-    of ``estimators.gnss_fusion.error_model``) predicts the correlation coefficient; the time series of seed 1 over
+    of ``error_model``) predicts the correlation coefficient; the time series of seed 1 over
     100-300 s must show it to ±0.15 (measured on seeds 1-6: 0.27 / 0.34 / 0.33 / 0.31 / 0.23 /
     0.43 against the model's 0.37 on each; the old model, the two added as independent, said
     0)."""

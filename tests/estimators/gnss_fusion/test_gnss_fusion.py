@@ -122,7 +122,7 @@ def test_a_held_attitude_in_a_large_roll_keeps_its_fixes():
     paper-001 set-up: roll 4.6° RMS), 1 Hz GNSS, 300 s. The held attitude turns by centiradians
     before the next fix and the accelerometer point's innovations grow with it. The gate weighs
     them against the error covariance's innovation variance, which models that rotation
-    (``estimators.gnss_fusion.error_model``): every fix accepted, measured COG RMS 0.91 / 10.3 / 6.0 cm N / E / D
+    (``error_model``): every fix accepted, measured COG RMS 0.91 / 10.3 / 6.0 cm N / E / D
     after 100 s (bound 20 cm), and ``pos_std`` not over-confident (error / ``pos_std`` RMS
     0.91 / 0.77 / 0.88, bound 1.3). Against the filter's own covariance alone the gate
     rejected 58 of the 301 fixes and the output drifted to 8 m RMS east."""
