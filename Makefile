@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench fmus clean
+.PHONY: demo test bench docs fmus clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -27,5 +27,10 @@ test: fmus
 bench: fmus
 	$(VENV)/bin/marinefmu bench --out bench
 
+# The documentation site into docs/_build/html, warnings as errors; the FMU pages read their
+# interface tables from the built FMUs, hence fmus first.
+docs: fmus
+	$(PY) -m sphinx -W --keep-going -b html docs docs/_build/html
+
 clean:
-	rm -rf $(VENV) fmus/*.fmu fmus/.build-stamps results bench
+	rm -rf $(VENV) fmus/*.fmu fmus/.build-stamps results bench docs/_build
