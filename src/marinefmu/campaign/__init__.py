@@ -1,5 +1,5 @@
 """Campaigns: many co-simulations of one system over a grid of sea states, seeds and sensor
-placements, run on Dask (issue 10).
+placements, run on Dask.
 
 ``marinefmu campaign SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR]`` reads a
 campaign file (:mod:`.spec`), runs each run as a Dask task (:mod:`.engine`, :mod:`.worker`),

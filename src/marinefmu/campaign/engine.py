@@ -188,8 +188,8 @@ def run_campaign(spec: CampaignSpec, out: str | Path, scheduler: str | None = No
         except KeyboardInterrupt:
             interrupted = True
             client.cancel(futures)
-            # Ctrl-C can fall between a run's log line and the table's rewrite (seen once in CI:
-            # 1 run in runs.jsonl, 0 in results.csv): the table follows the log again
+            # Ctrl-C can fall between a run's log line and the table's rewrite (a run in
+            # runs.jsonl but not in results.csv): the table follows the log again
             write_table(out, spec.axes, runs, read_log(out), spec.metrics)
             raise
         finally:

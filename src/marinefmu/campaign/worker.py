@@ -36,8 +36,8 @@ _FOLDERS: dict[str, tuple[Path, dict[Path, Path]]] = {}
 class Job:
     """What every run of a campaign shares (sent to each worker once, as the FMUs are: a task
     then carries only its :class:`~.spec.Run`; Dask's worker keeps its recent tasks' arguments in
-    a log of 1,000 events, which held a whole system per task and grew a worker's memory by
-    about 30 kB a run for its first 300 runs).
+    a log of 1,000 events, which would hold a whole system per task and grow the worker's memory
+    with every run).
 
     Attributes
     ----------
@@ -140,9 +140,9 @@ def run_one(run: Run, task: Job, fmus: dict[str, bytes]) -> dict[str, Any]:
 
 def _give_back_freed_memory() -> None:
     """Return the heap's free pages to the system after a run (glibc's ``malloc_trim``; nothing
-    elsewhere). Without it a worker's resident set crept up 80-150 kB a run after its warm-up,
-    pages freed by one run but kept by the allocator in the task thread's arena (measured by
-    ``marinefmu bench``, part ``campaign``)."""
+    elsewhere). Without it a worker's resident set creeps up run after run, pages freed by one
+    run but kept by the allocator in the task thread's arena (``marinefmu bench``, part
+    ``campaign``, measures a worker's memory over its runs)."""
     trim = _malloc_trim()
     if trim is not None:
         trim(0)

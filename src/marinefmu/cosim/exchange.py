@@ -1,21 +1,18 @@
 """The master's data exchange of one base step: read every needed output once, record, wire.
 
-:class:`~.system.SystemRunner` used to read each destination's sources separately (a source
-feeding five estimators was read five times at every step) and to read the recorded outputs
-again after the step, each read through FMPy's ``getReal``, which builds two ctypes arrays and
-a list per call. A scan on 2026-11-23 ran the ``system`` scenario with FMUs of the same
-variables that do nothing in ``doStep`` (the master's own cost): 128 µs per base step, 1.4 µs
-of it in each ``doStep``; with this exchange 69 µs. The real system went from 680 to 619 µs
-per base step (600 s, real-time factor 14.7 → 16.1, same machine, back to back).
+:class:`~.system.SystemRunner` runs it: after the components have stepped to t, every
+(component, type) that has a wired or a recorded output is read **once**, into a buffer
+allocated before the run; the recorded columns are copied from those buffers, and the inputs of
+the components due at t are gathered from them and set, one set call per (component, type).
+Reading each destination's sources separately (a source feeding five estimators read five times
+at every step) and the recorded outputs again after the step, each read through FMPy's
+``getReal``, which builds two ctypes arrays and a list per call, costs about as much as
+everything else the master does per base step.
 
-Here, after the components have stepped to t, every (component, type) that has a wired or a
-recorded output is read **once**, into a buffer allocated before the run; the recorded columns
-are copied from those buffers, and the inputs of the components due at t are gathered from
-them and set, one set call per (component, type). That is the same Jacobi exchange as before
-(every input sees the outputs held at t; all reads happen before any set), so results are bit
-for bit those of the earlier master: the same scan compared 30 s of the ``system`` and ``ahc``
-scenarios, every output of every component, under both engines (all equal); the runner's
-wiring and rate tests pass unchanged.
+It is a Jacobi exchange: every input sees the outputs held at t, and all reads happen before
+any set, so the results are bit for bit those of reading each source per destination (every
+output of every component of the ``system`` and ``ahc`` scenarios compared under both
+engines); the runner's wiring and rate tests check it.
 
 Through FMPy the calls go to the FMU's C functions directly (``fmi2GetReal`` … of
 ``FMU2Slave.dll``, with the argument types FMPy declared), on arrays made once; a status

@@ -219,8 +219,8 @@ class _Recorder:
 def _forget_paths(root: str) -> None:
     """Drop the ``sys.path`` entries (and their importer cache) under ``root``: pythonfmu's loader
     puts each instance's resources folder on ``sys.path`` and never takes it off, so a process
-    running system after system (a campaign worker) gained six entries a run, each a folder
-    already deleted, and every later import searched them all."""
+    running system after system (a campaign worker) would gain six entries a run, each a folder
+    already deleted, and every later import would search them all."""
     inside = root.rstrip(os.sep) + os.sep
     sys.path[:] = [p for p in sys.path if not p.startswith(inside)]
     for key in [k for k in sys.path_importer_cache if k.startswith(inside)]:

@@ -1,9 +1,10 @@
 """How well *could* a real-time estimator bridge a GNSS gap on paper 001's set-up? The best
 linear estimator that knows the sea's and the sensors' joint statistics (beyond the paper).
 
-Why: the wave coast of :mod:`~marinefmu.estimators.gnss_fusion.wave_coast` errs up to 15 cm east through a
-30 s dropout (README, paper 001), against the issue's goal of < 10 cm. Whether that goal is
-within reach of *any* causal estimator fed these sensors is a measurement, not an opinion. As
+Why: the wave coast of :mod:`~marinefmu.estimators.gnss_fusion.wave_coast` must bridge a 30 s
+dropout within the project goal of < 10 cm per axis, and its worst cases sit close to it (east,
+in a beam sea). Whether that goal is within reach of *any* causal estimator fed these sensors
+is a measurement, not an opinion. As
 for the heave observer (:func:`~marinefmu.papers.paper003.causal_bound`), the answer is a
 least-squares fit: for each time τ into a gap, one linear map from everything a real-time
 estimator has at t0 + τ to the COG position then,
@@ -23,9 +24,9 @@ channels — in a long-crested beam sea the roll that the gyro measures predicts
 is why it does much better than the per-axis wave model. It estimates the best linear
 estimator's error from above (finite memory and training, 4 Hz block means). An estimator that
 must learn the statistics in service cannot expect to reach it: refitted on the few minutes of
-fixes before each gap, the same fit errs 12.7 cm on average (30 s memory, 1 Hz) and 22.5 cm
-(60 s) over the 60 dropouts (a scan, ``docs/paper001_dropout.md``). So it shows the goal within reach in principle,
-and where the information is; it is not a floor that explains the wave coast's errors.
+fixes before each gap, the same fit errs far more than the wave coast (the dropout coast's
+decision records give the figures). So it shows the goal within reach in principle, and where
+the information is; it is not a floor that explains the wave coast's errors.
 
 Hand-written normal equations (numpy), as in :func:`~marinefmu.papers.paper003.causal_bound`:
 neither scipy nor python-control fits a multichannel causal Wiener filter from data.
@@ -46,7 +47,7 @@ TAUS = tuple(float(t) for t in range(1, 31))
 #: Seeds of the training records (not among :data:`~.paper001.DROPOUTS`' seeds 1-40).
 TRAIN_SEEDS = tuple(range(1001, 1009))
 #: Ridge on the normal equations, relative to their mean diagonal: the block means of smooth
-#: signals are nearly collinear; 1e-9 changes the fitted errors by < 1 % (scan).
+#: signals are nearly collinear; 1e-9 changes the fitted errors by < 1 %.
 RIDGE = 1e-9
 #: Axis index of each name (NED).
 AXES = {"north": 0, "east": 1}

@@ -29,9 +29,8 @@ NOISE_FREE = {"imu.acc_noise": 0.0, "imu.gyro_noise": 0.0, "imu.acc_bias_instabi
 DT = 0.01
 #: Screening frequency [Hz], about half the spectral peak (1/Tp = 0.083 Hz), where the sea
 #: holds no energy. With noisy sensors most of the error is the aided attitude's residual tilt
-#: error, whose g·ε acceleration lies at 0.02-0.06 Hz: at 0.03 Hz the sway error is 2.9-3.0 %
-#: (it moves with SVD round-off), at 0.04 Hz 2.2 %. Noise-free, 0.03 Hz scores 0.22 % and
-#: 0.04 Hz 0.25-0.50 % (a little true motion lies between the two).
+#: error, whose g·ε acceleration lies at 0.02-0.06 Hz: screening at 0.04 Hz rather than 0.03 Hz
+#: removes more of it than of the little true motion between the two.
 CUTOFF = 0.04
 #: Low-pass cutoff of the post-processed tilt refinement [Hz]: a quarter of the spectral peak.
 TILT_CUTOFF = 0.02

@@ -191,7 +191,7 @@ def tilting(rate: float = 1.0, duration: float = 600.0, settle: float = 60.0) ->
 
     The uncorrected filter runs without the innovation gate, as the paper's: its acceleration
     is off by g·sin(roll) (0.7 m/s² at 4°), so with the gate it rejects a fifth of the fixes
-    and coasts on that error (``uncorrected_gated``, 82 cm sway RMS over 600 s, measured 2026-11-22)."""
+    and coasts on that error (``uncorrected_gated``: a sway error of close to a metre RMS)."""
     rec = simulate(duration, {"gnss.rate": rate})
     out = {"gnss": rms(raw_gnss_cog(rec), rec["cog"], settle)}
     for name, kw in (("corrected", {}), ("uncorrected", {"attitude_correction": False, "gate": math.inf}),
@@ -233,22 +233,21 @@ def buoy(duration: float = 600.0, settle: float = 60.0, height: float = 0.97) ->
             "fused": err(r["pos"][s, 2] - rec["cog"][s, 2]), "roll_std_deg": float(np.degrees(rec["euler"][s, 0].std()))}
 
 
-#: The dropouts of the coast's figures in the README, (start [s], seed): at 270, 300 and 320 s
-#: of seeds 1-10 (used to choose the coast's settings), at 400 s of seeds 11-20 (not used) and,
-#: since 2026-11-24, at 350 s of seeds 21-40 (not used; they showed the tail the first 40 hid:
-#: 15.4 cm east on seed 27).
+#: The dropouts of the coast's bench figures, (start [s], seed): at 270, 300 and 320 s of seeds
+#: 1-10 (used to choose the coast's settings), at 400 s of seeds 11-20 and at 350 s of seeds
+#: 21-40 (neither used to choose settings).
 DROPOUTS = tuple((s, seed) for s in (270.0, 300.0, 320.0) for seed in range(1, 11)) + \
     tuple((400.0, seed) for seed in range(11, 21)) + tuple((350.0, seed) for seed in range(21, 41))
 
 
 #: The same (start + 900 s, seed): 19.5-21.7 min into a run, when the coast's spectrum window has
-#: grown to its longest (:data:`~marinefmu.estimators.heave.observer.WINDOW_MAX`, 1200 s), as it has
+#: grown to its longest (:data:`~marinefmu.estimators.heave.common.WINDOW_MAX`, 1200 s), as it has
 #: on a vessel that has been on station for a while; the dropouts above come 4.5-6.7 min into
 #: a run, with a spectrum from at most 400 s of data.
 LATE_DROPOUTS = tuple((start + 900.0, seed) for start, seed in DROPOUTS)
 
 
-#: Five-minute dropouts (start [s], seed), bridged by the wave coast (README): at 270 s of seeds 1-4.
+#: Five-minute dropouts (start [s], seed), bridged by the wave coast: at 270 s of seeds 1-4.
 LONG_DROPOUTS = tuple((270.0, seed) for seed in range(1, 5))
 
 
@@ -388,7 +387,7 @@ def pos_std_between_fixes(cases: dict = POS_STD_CASES) -> dict:
 def dropout_trace(start: float = 350.0, seed: int = 27, duration: float = 30.0, out: str | Path | None = None) -> dict:
     """One GNSS dropout (1 Hz RTK) traced: the fused COG's error per axis in real time, with its
     ``pos_std``, and RTS-smoothed, from 20 s before the gap to 10 s after it. The default is the
-    hardest of :data:`DROPOUTS` (seed 27 at 350 s, README).
+    hardest of :data:`DROPOUTS` (seed 27 at 350 s).
 
     Returns ``max_error_m`` (real time) and ``max_error_smoothed_m`` per axis in the gap [m],
     and ``max_z`` per axis: the largest |error| / ``pos_std`` in the gap once the coast's
@@ -434,7 +433,7 @@ def _plot_dropout(err: np.ndarray, err_s: np.ndarray, std: np.ndarray, start: fl
         a.legend(loc="lower left", fontsize=7, ncol=2)
     ax[-1].set_xlabel("time [s]")
     fig.suptitle(f"Paper 001 set-up, 1 Hz RTK: COG error through a {duration:g} s GNSS dropout at {start:g} s "
-                 f"(seed {seed}); dotted: the issue's 10 cm", fontsize=10)
+                 f"(seed {seed}); dotted: the project goal, 10 cm", fontsize=10)
     fig.tight_layout()
     fig.savefig(out / "paper001_dropout.png", dpi=100)
     plt.close(fig)
