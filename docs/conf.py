@@ -37,7 +37,7 @@ extensions = [
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
 # Markdown files in docs/ that are not pages of the site.
-exclude_patterns = ["_build", "_ext", "README.md", "**/README.md", "paper001_dropout.md"]
+exclude_patterns = ["_build", "_ext", "README.md", "**/README.md"]
 
 # MyST: ::: fences, definition lists, $...$ and $$...$$ maths; anchors for headings up to level 3
 # so that links like [text](concepts.md#frames-and-signs) resolve.

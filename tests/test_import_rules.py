@@ -10,6 +10,8 @@ also one inside a function or under ``TYPE_CHECKING``):
   (``estimators.gnss_fusion.wave_coast`` and its band observer ``.aided_band``) may also use
   paper 003's observer and its oscillator bank (``estimators.heave``), which it runs on the
   fusion's own acceleration during a GNSS dropout;
+- the heave compensation's winch, controller and design import only estimators, sea and the shared
+  modules (``ahc.loop`` runs systems);
 - no module uses another module's private name (``from x import _y`` or ``x._y``).
 """
 from __future__ import annotations
@@ -174,6 +176,16 @@ def test_an_estimator_package_imports_only_the_shared_modules_and_itself(name):
     assert modules, own
     bad = [str(i) for m, imps in modules.items() for i in imps
            if within(i.target, (PACKAGE,)) and not within(i.target, (own, *SHARED, *ALLOWED_BEYOND.get(m, ())))]
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("module", ["marinefmu.ahc.winch", "marinefmu.ahc.controller", "marinefmu.ahc.design"])
+def test_the_heave_compensation_physics_and_design_use_only_estimators_sea_and_shared(module):
+    """The winch, the controller and their design are models: they run without FMI or a system
+    runner (only ``ahc.loop`` runs systems)."""
+    allowed = ("marinefmu.ahc", "marinefmu.estimators", "marinefmu.sea", "marinefmu.frames", "marinefmu.errors")
+    bad = [str(i) for i in IMPORTS[module] if within(i.target, (PACKAGE,)) and not within(i.target, allowed)]
+    bad += [str(i) for i in IMPORTS[module] if within(i.target, FMI_LIBRARIES)]
     assert not bad, "\n".join(bad)
 
 

@@ -21,6 +21,10 @@ from scipy.spatial.transform import Rotation
 G = 9.80665
 #: Gravity vector in NED [m/s²].
 GRAVITY_N = np.array([0.0, 0.0, G])
+#: Lowest frequency of heave [rad/s]: heave is the vertical motion at periods up to 2π/0.2 = 31 s.
+#: Wave periods at sea are 3-25 s; slower vertical motion (a drifting attitude times a lever arm)
+#: is not heave, nor what heave compensation is for. Used by the AHC scores and design.
+HEAVE_CUTOFF = 0.2
 
 
 def rot_nb(roll: float, pitch: float, yaw: float) -> np.ndarray:

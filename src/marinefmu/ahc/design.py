@@ -50,6 +50,7 @@ import numpy as np
 from .controller import AhcControllerParams
 from .winch import AhcWinchParams
 from ..errors import ParameterError, check_range
+from ..frames import HEAVE_CUTOFF
 
 
 @dataclass(frozen=True)
@@ -200,10 +201,9 @@ def _noise(resp: EstimatorResponse, m: np.ndarray, a: np.ndarray, b: np.ndarray)
 
 
 def _noise_power(resp: EstimatorResponse, winch: AhcWinchParams, ctrl: AhcControllerParams, step: float) -> float:
-    """Σ |W|² S_v,noise over every frequency of heave (ω ≥ :data:`~.scoring.HEAVE_CUTOFF`),
+    """Σ |W|² S_v,noise over every frequency of heave (ω ≥ :data:`~marinefmu.frames.HEAVE_CUTOFF`),
     per unit k_ff²: the estimates' noise reaches the load wherever it is, not only where the
     sea is."""
-    from ..analysis.scoring import HEAVE_CUTOFF
 
     m = resp.omega >= HEAVE_CUTOFF
     s = 1j * resp.omega[m]

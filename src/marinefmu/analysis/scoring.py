@@ -28,7 +28,7 @@ winches of one run are compared on the same waves. Per winch: ``tip_heave_cm`` a
 ``tip_motion_cm``, ``load_motion_cm`` and ``residual_total_pct`` the same over all
 frequencies; ``limited_pct``, the percentage of steps with any limit flag set, and
 ``speed_limited_pct``, ``acc_limited_pct``, ``stroke_limited_pct``, ``slack_pct`` per flag.
-**Heave** is the vertical motion at periods shorter than 2π/:data:`HEAVE_CUTOFF` = 31 s (wave
+**Heave** is the vertical motion at periods shorter than 2π/:data:`~marinefmu.frames.HEAVE_CUTOFF` = 31 s (wave
 periods at sea are 3-25 s; slower vertical motion, such as a drift of the attitude input times
 a lever arm, is not heave and is not what heave compensation is for), taken with a zero-phase
 4th-order Butterworth high pass (``scipy.signal.sosfiltfilt``: no phase error in the band).
@@ -49,9 +49,7 @@ import math
 import numpy as np
 
 from ..cosim.ssp import SystemDescription
-
-#: Lowest frequency of heave [rad/s] in the AHC scores (module docstring): periods up to 31 s.
-HEAVE_CUTOFF = 0.2
+from ..frames import HEAVE_CUTOFF
 #: The winch's limit flags, scored as percentages of time.
 LIMIT_FLAGS = ("speed_limited", "acc_limited", "stroke_limited", "slack")
 #: Every metric :func:`score` can give, per FMU (module docstring); which ones a run gives
