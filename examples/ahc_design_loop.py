@@ -1,4 +1,4 @@
-"""A heave-compensation design loop to copy and change (issue 9).
+"""A heave-compensation design loop to copy and change.
 
 It does by hand what ``marinefmu design-ahc`` does, so each step can be swapped for your own:
 

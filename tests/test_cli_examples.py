@@ -19,13 +19,13 @@ def test_sdof_example_prints_its_error_and_writes_its_plot(tmp_path, capsys):
     assert main(["example", "paper000-sdof", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     line = next(s for s in out.splitlines() if "max displacement error" in s)
-    assert float(line.split()[-1]) < 0.5  # the issue's goal, % of peak (measured 0.0022)
+    assert float(line.split()[-1]) < 0.5  # the project's goal, % of peak (measured 0.0022)
     assert (tmp_path / "paper000_sdof.png").stat().st_size > 10000
 
 
 def test_heave_example_beats_the_paper_modes_and_the_high_pass_baseline(tmp_path):
     """Paper 003 example, shortened to 5 min: the default band observer is more accurate at the
-    bow point than the paper's modes and the classical high-pass integration (README figures
+    bow point than the paper's modes and the classical high-pass integration (docs/papers.md,
     over 12 min: band 1.0 cm, modes 4-5 cm, high-pass 13 cm at the IMU), and the plot is written."""
     from marinefmu.papers import paper003
 

@@ -1,4 +1,4 @@
-"""The AHC controller (issue 9): its law, bad inputs, anti-windup, and the loop closed around
+"""The AHC controller: its law, bad inputs, anti-windup, and the loop closed around
 the winch in co-simulation with the true crane-tip motion (the ideal the observer-fed loop is
 to be compared with)."""
 import math

@@ -1,4 +1,4 @@
-"""The python-control design of the AHC length loop (issue 9): it reproduces its stated
+"""The python-control design of the AHC length loop: it reproduces its stated
 margins, refuses what it cannot do, and the designed gains hold the load in co-simulation."""
 import math
 

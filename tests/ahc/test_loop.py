@@ -1,8 +1,8 @@
-"""Heave compensation closed around the estimators in co-simulation (issue 9): the built-in
-scenario ``ahc`` (VesselMotion → AttitudeEstimator → HeaveObserver → AhcController → AhcWinch,
-beside the truth-fed, classical-fed and uncompensated winches) against the issue's goals, the
-design loop (identify, tune, verify, write), and the same system under FMPy, in-process and
-OSP libcosim."""
+"""Heave compensation closed around the estimators in co-simulation: the built-in scenario
+``ahc`` (VesselMotion → AttitudeEstimator → HeaveObserver → AhcController → AhcWinch, beside the
+truth-fed, classical-fed and uncompensated winches) against the project's goals
+(docs/heave_compensation.md), the design loop (identify, tune, verify, write), and the same
+system under FMPy, in-process and OSP libcosim."""
 import tomllib
 from dataclasses import replace
 
@@ -100,14 +100,12 @@ def test_a_loop_with_a_missing_piece_is_refused_by_name():
 @pytest.mark.fmu
 def test_four_ways_to_drive_the_winch_against_the_goals(fmu_dir):
     """The built-in scenario ``ahc``, 38 min (31 scored) at Hs 3 m, Tp 9 s, FMPy runner.
-    Measured 2026-11-23: the load's heave (periods < 31 s) is 100.5 % of the tip's with no
-    compensation, 1.02 % fed the truth, 4.89 % fed the classical filter (at its best cutoff),
-    0.95 % fed our observer (0.96 % with window_max 600 s, 1.08 % before the growing spectrum
-    window); over all frequencies
-    the observer-fed load moves 2.43 % (the AttitudeEstimator's slow 0.03° error times the 45 m
-    lever arm; truth-fed 1.02 %). The linear model of the design predicts the two loops from
-    this run's identified observer to 15 % (predicted 1.00 % and 1.03 %; 1.04 % and 1.02 %
-    before)."""
+    Measured: the load's heave (periods < 31 s) is 100.5 % of the tip's with no compensation,
+    1.02 % fed the truth, 4.89 % fed the classical filter (at its best cutoff), 0.95 % fed our
+    observer (0.96 % with window_max 600 s); over all frequencies the observer-fed load moves
+    2.43 % (the AttitudeEstimator's slow 0.03° error times the 45 m lever arm; truth-fed 1.02 %).
+    The linear model of the design predicts the two loops from this run's identified observer to
+    15 % (predicted 1.00 % and 1.03 %)."""
     from marinefmu.cosim.system import SystemRunner
     from marinefmu.analysis.scoring import score
 

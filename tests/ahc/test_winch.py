@@ -1,4 +1,4 @@
-"""The AHC winch and load model (issue 9) against analytic responses."""
+"""The AHC winch and load model against analytic responses."""
 import math
 
 import numpy as np

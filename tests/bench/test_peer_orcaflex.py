@@ -1,9 +1,10 @@
-"""Someone else's data (issue 7, item 5): marinefmu's attitude, heave and GNSS fusion on the
+"""Someone else's data (docs/benchmarks.md): marinefmu's attitude, heave and GNSS fusion on the
 OrcaFlex record of the smsfusion project (MIT licence, 4Subsea; see
 src/marinefmu/data/peer/smsfusion_orcaflex/README.md), beside smsfusion on the same file.
 
 The record is fixed and the runs are deterministic; absolute bounds are the measured figures
-(2026-11-22) plus 10 %, room for BLAS and platform rounding, not for a change of method."""
+(docs/benchmarks.md, part ``orcaflex``) plus 10 %, room for BLAS and platform rounding, not for
+a change of method."""
 import numpy as np
 import pytest
 
@@ -49,8 +50,7 @@ def test_roll_and_pitch_beat_smsfusion_vru_and_ahrs(scores):
 def test_heave_from_the_accelerometer_alone(scores):
     """HeaveObserver on the AttitudeEstimator's roll and pitch, from the moment it turns valid
     (120 s), on a 75 cm (std) heave: the default (model = "wiener", the Wiener filter from the
-    spectrum) 2.67 cm RMS, model = "band" 3.32 cm (bench part orcaflex 2026-11-23; 3.28 before
-    the growing window and integrated band variances)."""
+    spectrum) 2.67 cm RMS, model = "band" 3.32 cm (bench part ``orcaflex``)."""
     h = scores["marinefmu HeaveObserver"]
     assert 119.0 < h["from_s"] < 121.0 and h["heave_std_cm"] > 60.0
     assert h["heave_cm"] < 2.9, scores

@@ -1,6 +1,6 @@
 """marinefmu's AttitudeEstimator beside smsfusion's VRU on the same VesselMotion record
-(issue 7: every estimator at least as accurate as the peer where both estimate the same
-quantity). The calm / moderate / rough comparison is in ``make bench`` (part ``peer``)."""
+(the project's goal: every estimator at least as accurate as the peer where both estimate the
+same quantity). The calm / moderate / rough comparison is in ``make bench`` (part ``peer``)."""
 import pytest
 
 from marinefmu.bench.peer_smsfusion import compare_attitude, system_sea

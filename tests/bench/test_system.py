@@ -11,7 +11,7 @@ from marinefmu.bench.system import peak_rss_mb
 
 def test_a_worker_reports_its_own_peak_not_its_parents():
     """Linux keeps ``ru_maxrss`` across ``execve``: a worker started by a bench process holding
-    300 MB read 300 MB or more, whatever it used itself (2026-11-23: 313 MB for every engine).
+    300 MB read 300 MB or more, whatever it used itself (measured: 313 MB for every engine).
     VmHWM starts afresh at exec."""
     held = np.ones(300 * 2**20 // 8)                       # 300 MB resident in this process
     assert peak_rss_mb() > 300.0
@@ -23,7 +23,7 @@ def test_a_worker_reports_its_own_peak_not_its_parents():
 
 @pytest.mark.fmu
 def test_idle_fmus_have_the_variables_of_the_real_ones_and_do_nothing(fmu_dir, tmp_path):
-    """The master's floor (bench_system.master_floor) runs the system scenario on FMUs with the
+    """The master's floor (bench.system.master_floor) runs the system scenario on FMUs with the
     same variables whose doStep does nothing: they must load where the real ones do, be wired
     the same way, and hold their start values."""
     import zipfile

@@ -1,5 +1,5 @@
-"""Campaigns on Dask (issue 10): the spec's refusals, the grid, and a real LocalCluster run with a
-deliberately failing run, resume and a torn log line."""
+"""Campaigns on Dask (docs/campaigns.md): the spec's refusals, the grid, and a real LocalCluster
+run with a deliberately failing run, resume and a torn log line."""
 from __future__ import annotations
 
 import json

@@ -17,7 +17,7 @@ sea = { hs = 2.0, tp = 7.0 }
 """
 
 
-def test_builtin_default_is_the_issue_scenario():
+def test_builtin_default_is_the_vessel_alone_scenario():
     s = load_scenario("default")
     p = s.system.components[0].parameters
     assert s.duration == 600.0 and p["sea.hs"] == 2.5 and p["sea.tp"] == 9.0

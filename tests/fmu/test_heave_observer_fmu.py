@@ -1,5 +1,5 @@
-"""OscillatorBankHeave FMU run by FMPy equals the in-process observer bit for bit (with a NaN sample),
-and saves/restores its state."""
+"""The HeaveObserver FMU run by FMPy equals the in-process observer bit for bit (with a NaN
+sample), and saves/restores its state."""
 import math
 
 import numpy as np

@@ -96,7 +96,7 @@ def test_levelling_from_a_static_tilt():
 
 def test_drift_corrected_roll_pitch_on_the_semisub():
     """Noise-free sensors: the aided filter keeps roll/pitch within the 0.02° goal; with the
-    default MEMS noise (10°/h gyro bias instability) it reaches 0.07° (README, issue note)."""
+    default MEMS noise (10°/h gyro bias instability) it reaches 0.07° (docs/fmus/AttitudeEstimator.md)."""
     gyro, acc, truth = vessel_record(600.0, noise=False)
     r = estimate_attitude(gyro, acc, 0.01, AttitudeEstimatorParams(init_euler=(0.0, 0.0, float(truth[0, 2]))))
     s = slice(20000, None)  # after levelling and convergence

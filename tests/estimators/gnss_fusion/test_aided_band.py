@@ -174,8 +174,8 @@ def coast_phase(dt, period=8.0, amplitude=0.3):
 def test_block_means_of_point_samples_add_no_lag():
     """At 100 Hz the coast averages five samples per 20 Hz band step; its position must not lag
     more than at 20 Hz, where each sample is a step. Measured: 11.4 ms at both (the filter's own
-    lag, 0.5 % amplitude); until 2026-11-24 the band filters averaged two block means again and
-    lagged 31.4 ms at 100 Hz, 2.5 cm on a 1 m sway at 0.8 rad/s. Bound: 2 ms apart."""
+    lag, 0.5 % amplitude); band filters that averaged two block means again would lag 31.4 ms
+    at 100 Hz, 2.5 cm on a 1 m sway at 0.8 rad/s. Bound: 2 ms apart."""
     gain_20, lag_20 = coast_phase(0.05)
     gain_100, lag_100 = coast_phase(0.01)
     assert abs(lag_100 - lag_20) < 0.002, (lag_20, lag_100)
@@ -231,7 +231,7 @@ def tilted_gap(seed, tilt, offset_noise, arw=0.0, model_arw=False, wave_tilt=Non
 def test_tilt_states_follow_the_attitude_error_through_a_gap(seed):
     """A wandering tilt of the correcting attitude: with the tilt states (and a tight offset,
     1e-4) the gap's max error was measured 5.1 / 5.6 / 4.8 cm (seeds 4-6), against 9.1-9.3 cm
-    for the loose offset (1e-3) that stood in for the tilt before, and 31-33 cm for a tight
+    for a loose offset (1e-3) standing in for the tilt states, and 31-33 cm for a tight
     offset without them. Bound: under 0.7 × the loose offset's. Before the gap the tilt
     estimate errs 0.16-0.27 mrad RMS, as its covariance says (0.24 mrad); bound 1.5 ×."""
     loose = tilted_gap(seed, False, 1e-3)[0]

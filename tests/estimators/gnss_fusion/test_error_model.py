@@ -99,14 +99,15 @@ def test_pos_std_between_fixes_tells_the_error(case):
     acceleration, the buoy, the held attitude). Measured RMS 0.89 / 0.88 / 0.99 (1 Hz), 0.89 /
     0.80 / 1.00 (10 Hz), 0.84 / 1.05 / 1.27 uncorrected (east off by g·sin(roll), 14.5 cm RMS:
     without the consistency check 14 there), 0.76 / 0.76 / 0.99 the buoy, 0.91 / 1.04 / 1.03
-    the held attitude (1.53 down before the rotation since the fix was modelled, session 27).
+    the held attitude (1.53 down if the model leaves out the vessel's rotation since the fix).
     Bounds RMS 0.7-1.3 and beyond 2 at most 10 % of the time (Gaussian 4.6 %): the error is
-    correlated over seconds to tens of seconds, so 200 s hold some twenty independent samples, whose RMS scatters by ±16 % (1σ)
-    and the fraction beyond 2 by ±4.7 %. Until 2026-11-24 ``pos_std`` was the filter's own
-    covariance, 3-8.5 cm on errors of 0.7 cm: RMS 0.13-0.19 at 1 Hz; until 2026-11-24 (session
-    26) the attitude's share was added as independent of the position error: 0.76 / 0.73 at
-    1 Hz and 0.66 / 0.61 on the buoy horizontally, the latter failing the lower bound. Every
-    epoch is accepted (the uncorrected case runs ungated, as the paper)."""
+    correlated over seconds to tens of seconds, so 200 s hold some twenty independent samples,
+    whose RMS scatters by ±16 % (1σ) and the fraction beyond 2 by ±4.7 %. The filter's own
+    covariance as ``pos_std`` (3-8.5 cm on errors of 0.7 cm) would read RMS 0.13-0.19 at 1 Hz;
+    the attitude's share added as independent of the position error would read 0.76 / 0.73 at
+    1 Hz and 0.66 / 0.61 on the buoy horizontally, the latter failing the lower bound
+    (docs/decisions/gnss-fusion-pos-std.md). Every epoch is accepted (the uncorrected case runs
+    ungated, as the paper)."""
     rate, seeds, kw, setup = paper001.POS_STD_CASES[case]
     r = paper001.pos_std_run(rate, seeds[0], kw, setup)
     rms_z, beyond = np.array(r["rms_z"]), np.array(r["beyond_2"])
@@ -120,8 +121,7 @@ def test_the_joint_covariance_tells_how_position_and_attitude_errors_go_together
     point by ε over the arm, and the filter follows both. The joint covariance (module docstring
     of ``error_model``) predicts the correlation coefficient; the time series of seed 1 over
     100-300 s must show it to ±0.15 (measured on seeds 1-6: 0.27 / 0.34 / 0.33 / 0.31 / 0.23 /
-    0.43 against the model's 0.37 on each; the old model, the two added as independent, said
-    0)."""
+    0.43 against the model's 0.37 on each; a model adding the two as independent says 0)."""
     rec = paper001.simulate(300.0, {"gnss.rate": 1.0, "sea.seed": 1, "sensors.seed": 1})
     est = GnssAccFusion(paper001.params())
     use = rec["gnss_new"] & rec["gnss_valid"]

@@ -124,8 +124,8 @@ def test_a_held_attitude_in_a_large_roll_keeps_its_fixes():
     them against the error covariance's innovation variance, which models that rotation
     (``error_model``): every fix accepted, measured COG RMS 0.91 / 10.3 / 6.0 cm N / E / D
     after 100 s (bound 20 cm), and ``pos_std`` not over-confident (error / ``pos_std`` RMS
-    0.91 / 0.77 / 0.88, bound 1.3). Against the filter's own covariance alone the gate
-    rejected 58 of the 301 fixes and the output drifted to 8 m RMS east."""
+    0.91 / 0.77 / 0.88, bound 1.3). Against the filter's own covariance alone the gate would
+    reject 58 of the 301 fixes and the output drift to 8 m RMS east."""
     rec = paper001.simulate(300.0, {"gnss.rate": 1.0, "sea.seed": 1, "sensors.seed": 1, "sea.tp": 12.0})
     r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(propagation="hold"),
              gnss_valid=rec["gnss_valid"])
@@ -142,8 +142,8 @@ def test_a_held_attitude_coasts_a_dropout_on_the_gyro():
     wave coast runs on it with its tilt states. Measured max error N / E / D from 1.5 s into
     the gap 1.4 / 7.8 / 1.9 cm (bound 15 cm; the gyro mode's 1.1 / 5.5 / 3.0 cm); valid
     throughout. Before the first missed epoch the error is the held attitude's, as between
-    any two fixes (34 cm east at 0.98 s here). When the held attitude stayed through the gap,
-    east was 5.7 m off, flagged valid, at 8.5 ``pos_std``. Without a gyro nothing follows the
+    any two fixes (34 cm east at 0.98 s here). An attitude held through the whole gap puts
+    east 5.7 m off, flagged valid, at 8.5 ``pos_std``. Without a gyro nothing follows the
     attitude: the output is finite but not valid from the first overdue fix (0.49 s into the
     gap here) until GNSS returns, and valid throughout the 200 s before."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
@@ -245,20 +245,19 @@ def test_a_20_m_jump_is_gated_out():
 def test_dropout_wave_coast_and_smoother_stay_within_goal(seed):
     """1 Hz GNSS, a 30 s dropout at 300 s (the band observers' 180 s spectrum window and 120 s
     of fixes before it). Real time with ``coast="band"`` (default, the GNSS-aided band observer
-    of estimators.gnss_fusion.aided_band with its tilt states and the wave-tilt band, on its own slower
-    attitude): measured max per axis 1.8-4.3 / 4.7-6.3 / 2.1-3.0 cm north / east / down over
-    seeds 1-3 (session 33; east 4.8-7.4 cm without the wave-tilt band, 5.1-8.3 cm before the
-    gyro's angle random walk in the tilt states; the line coast before them: east 8.4 / 3.8 /
-    11.2 cm), against metres for the inertial coast (README). The goal, 10 cm per axis, is the
-    bound. RTS-smoothed through the gap: measured max 1.2-2.5 / 4.3-4.7 / 1.7-2.7 cm (bound
-    10 cm). Back within 5 cm (3-D) 5 s after the fixes return (measured 2.4-2.9 cm), and valid
-    throughout (within max_coast).
+    of estimators.gnss_fusion.aided_band with its tilt states and the wave-tilt band, on its
+    own slower attitude): measured max per axis 1.8-4.3 / 4.7-6.3 / 2.1-3.0 cm north / east /
+    down over seeds 1-3 (east 4.8-7.4 cm without the wave-tilt band; the variants in
+    docs/decisions/gnss-fusion-dropout.md), against metres for the inertial coast
+    (docs/fmus/GnssAccFusion.md). The goal, 10 cm per axis, is the bound. RTS-smoothed through
+    the gap: measured max 1.2-2.5 / 4.3-4.7 / 1.7-2.7 cm (bound 10 cm). Back within 5 cm (3-D)
+    5 s after the fixes return (measured 2.4-2.9 cm), and valid throughout (within max_coast).
 
     ``pos_std`` tells the error in the gap (from the first pseudo-fix on): the error over it,
     z, measured RMS 0.38-1.13 per seed and axis, at most 2.3 (bounds 0.3-2 and 3.5: z over
     28 s has few independent samples, so the band only catches a scale off by 3 either way).
-    Until 2026-11-24 it added the coast's variance to the filter's own, which the pseudo-fixes
-    held near 6.5 cm whatever the error: RMS z 0.10-0.59, failing the lower bound."""
+    Adding the coast's variance to the filter's own, which the pseudo-fixes hold near 6.5 cm
+    whatever the error, would read RMS z 0.10-0.59, failing the lower bound."""
     rec = paper001.simulate(340.0, {"gnss.rate": 1.0, "gnss.dropout.start": 300.0, "gnss.dropout.duration": 30.0,
                                     "sea.seed": seed, "sensors.seed": seed})
     r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(),
@@ -299,13 +298,11 @@ def test_the_dropout_bench_reports_errors_and_the_pos_std_check():
 
 def test_a_tactical_gyro_takes_the_hardest_dropout_under_the_goal():
     """The tail of the 30 s dropout is the coast's tilt estimate, turned by the gyro through the
-    gap (README, "The 30 s dropout goal"). Seed 27 at 350 s, the hardest of the 60 early
-    dropouts with the default MEMS gyro (9.9 cm east with the wave tilt, 10.7 cm before), with a
-    tactical-grade gyro in the simulation and told to the fusion (``paper001.TACTICAL_GYRO``,
-    bench part ``dropout_gyro``): measured 7.8 cm against 9.9 cm (session 33; 8.26 against
-    10.7 cm before the wave tilt) (bound 9 cm, and 0.5 cm under the MEMS gyro's). Its bias
-    instability alone with the MEMS gyro's white noise: 10.1 cm (a scan before the wave tilt;
-    12.2 cm while the tilt states modelled the bias but not the angle random walk)."""
+    gap (the 30 s dropout goal in docs/fmus/GnssAccFusion.md and
+    docs/decisions/gnss-fusion-dropout.md). Seed 27 at 350 s, the hardest of the 60 early
+    dropouts with the default MEMS gyro (9.9 cm east), with a tactical-grade gyro in the
+    simulation and told to the fusion (``paper001.TACTICAL_GYRO``, bench part ``dropout_gyro``):
+    measured 7.8 cm against 9.9 cm (bound 9 cm, and 0.5 cm under the MEMS gyro's)."""
     tactical = paper001.dropouts(((350.0, 27),), gyro=paper001.TACTICAL_GYRO)
     mems = paper001.dropouts(((350.0, 27),))
     east, east_mems = tactical["cases"][0]["max_error_m"][1], mems["cases"][0]["max_error_m"][1]
@@ -317,7 +314,7 @@ def test_coast_tilt_states_follow_the_true_attitude_error():
     """Seed 27 (a gyro-bias swing), 1 Hz GNSS, no dropout: from the first spectrum (180 s) to
     300 s, the coast's tilt states against the true error of the coast's attitude, once a
     second. Measured RMS error 0.16 / 0.08 mrad about N / E on errors of 1.5 / 1.3 mrad RMS
-    (session 33, with the wave-tilt band; 0.22 / 0.15 mrad by the acceleration alone) (bound
+    (with the wave-tilt band; 0.22 / 0.15 mrad by the acceleration alone) (bound
     0.4 / 0.3 mrad and a quarter of the error itself; the attitude fix's sign flipped errs
     1.1 / 2.8 mrad, the band observer's offset kept at the first model 0.7 / 1.5 mrad, both
     without the wave-tilt band)."""
@@ -355,13 +352,13 @@ def test_inertial_coast_drifts_as_the_gyro_floor_says():
 def test_five_minute_dropout_is_bridged_by_the_wave_coast():
     """1 Hz GNSS, 300 s dropout at 270 s, seed 2 (the worse of seeds 1-2). The wave coast gives
     pseudo-fixes through the whole gap: max error per axis measured 12.8 / 23.1 / 5.2 cm
-    (session 33; bound 40 cm; the inertial coast used to take over after ``coast_window``,
-    120 s, and was kilometres off). ``pos_std`` is the coast's own standard deviation and the
-    output's spread about it: 22 / 23 / 19 cm at the end, above the error then (10 / 16 / 4 cm;
-    error over ``pos_std`` through the gap RMS 0.57 / 0.74 / 0.40, at most 2.2). ``valid`` is false after
-    ``max_coast``; the first fix re-initialises the filter with the coasted velocity (15 / 18 /
-    2 cm in the first 5 s, against 2 / 32 / 40 cm for a restart at rest) and from 5 s later the
-    error is back under 3 cm (measured 2.1 / 1.8 / 2.0 cm; bound 5 cm)."""
+    (bound 40 cm; an inertial coast taking over after 120 s would be kilometres off).
+    ``pos_std`` is the coast's own standard deviation and the output's spread about it:
+    22 / 23 / 19 cm at the end, above the error then (10 / 16 / 4 cm; error over ``pos_std``
+    through the gap RMS 0.57 / 0.74 / 0.40, at most 2.2). ``valid`` is false after
+    ``max_coast``; the first fix re-initialises the filter with the coasted velocity
+    (15 / 18 / 2 cm in the first 5 s, against 2 / 32 / 40 cm for a restart at rest) and from 5 s
+    later the error is back under 3 cm (measured 2.1 / 1.8 / 2.0 cm; bound 5 cm)."""
     start, dur = 270.0, 300.0
     rec = paper001.simulate(start + dur + 30.0, {"gnss.rate": 1.0, "gnss.dropout.start": start,
                                                  "gnss.dropout.duration": dur, "sea.seed": 2, "sensors.seed": 2})
@@ -428,7 +425,7 @@ def test_wave_coast_recovers_a_moving_wave_record():
     (different phases) and a 2e-3 m/s² accelerometer offset. With GNSS anchors every second
     for the first 300 s, the coast position through the next 30 s stays within 2 cm of
     truth (measured 0.5 / 0.5 / 0.2 cm N / E / D: the offset state takes the bias, the drift
-    states the 0.1 m/s; 0.6 cm with the line coast before)."""
+    states the 0.1 m/s)."""
     dt, w = 0.05, 2 * math.pi / 10.0
     t = np.arange(1, int(330 / dt) + 1) * dt
     phase = np.array([0.0, 1.0, 2.0])
@@ -492,9 +489,10 @@ def test_one_receiver_pos_std_is_the_receivers():
     """fuse_receiver with a noisy receiver (1 cm / 1.5 cm white at 1 Hz, ``antenna_sigma_h`` /
     ``_v`` of the params) and a MEMS accelerometer (7e-4 m/s²/√Hz) on a still point: error /
     ``pos_std`` RMS per axis over the last 500 s, measured 0.95-1.04; bound 0.75-1.3 (about
-    500 independent fixes, but the filter's memory spans several). Before, the virtual antennas'
-    centroid was taken for the mean of four independent antennas (σ/2) and their 10 m mean arm
-    added a fix attitude's share (1.9 cm) that a rigid virtual set does not have."""
+    500 independent fixes, but the filter's memory spans several). ``pos_std`` takes the
+    virtual antennas' centroid for the one receiver it is, not for the mean of four independent
+    antennas (σ/2), and adds no fix attitude's share for their 10 m mean arm (1.9 cm): a rigid
+    virtual set has none."""
 
     rng = np.random.default_rng(5)
     n, dt = 60000, 0.01
@@ -521,10 +519,10 @@ def test_orphan_steps_are_those_no_later_fix_reaches():
 
 def test_smoother_keeps_the_real_time_output_through_a_gap_ending_in_a_restart():
     """A 70 s dropout (> ``max_coast``, 60 s) ends in a re-initialisation, across which the
-    smoother has no fix: over the gap ``pos_smooth`` is ``pos`` (before, the filter's bias
-    drift in the gap was spread back over it: 5-min gaps 31.0 cm east against 23.5 cm real
-    time, README), while before the gap, with fixes after each step, it still smooths.
-    Measured before this: the smoothed east RMS over the gap 8.04 cm against 7.78 real time."""
+    smoother has no fix: over the gap ``pos_smooth`` is ``pos`` (smoothing across the restart
+    would spread the filter's bias drift in the gap back over it: through 5-min gaps 31.0 cm
+    east against 23.5 cm real time, docs/decisions/gnss-fusion-filter.md), while before the
+    gap, with fixes after each step, it still smooths."""
     rec = paper001.dropout_record(200.0, 2, 70.0)
     r = fuse(rec["acc"], paper001.DT, rec["gnss"], rec["gnss_new"], rec["gyro"], paper001.params(),
              gnss_valid=rec["gnss_valid"], smooth=True)

@@ -37,7 +37,8 @@ def _run(params, acc, roll, pitch, dt=DT):
 @pytest.mark.parametrize("model,measurement,tol", [
     ("peaks", "increment", 1e-3), ("peaks", "paper", 1e-3),
     # the band model's elements have a width, so a pure line is not its model: measured 8.1e-3
-    # (real time) and 3.7e-3 (delayed), the price of its accuracy on real, broad seas (README)
+    # (real time) and 3.7e-3 (delayed), the price of its accuracy on real, broad seas
+    # (docs/fmus/HeaveObserver.md)
     ("band", "increment", 1e-2),
 ])
 def test_exact_sum_of_sinusoids_is_recovered(model, measurement, tol):
@@ -210,7 +211,7 @@ def test_band_elements_integrate_the_heave_spectrum_over_their_bands():
     acc[(omega < 0.35) | (omega > 1.15)] = 0.0         # all energy inside the band
     _, var = band_elements(Spectrum(omega, acc, acc, acc, acc), grid, 0.0)
     assert var.sum() == pytest.approx(np.sum(acc / omega ** 4) * d, rel=1e-12)
-    w, var = band_elements(Spectrum(omega, acc, acc, acc, acc), grid, 0.0, "point")   # the earlier reading
+    w, var = band_elements(Spectrum(omega, acc, acc, acc, acc), grid, 0.0, "point")   # read at ω_j
     s_z = np.interp(grid, omega, acc) / grid ** 4
     inside = s_z > 0                                   # the end elements at 0.3 and 1.2 rad/s read zero
     np.testing.assert_allclose(w, grid[inside], rtol=1e-12)
@@ -298,7 +299,7 @@ def _errors(record, out, obs, settle=120.0):
 
 
 @pytest.mark.parametrize("hs,tp,model", [
-    # measured (bench part heave, 2026-11-23, window_max 1200 s) IMU / point / delayed [cm]
+    # measured (bench part heave, window_max 1200 s) IMU / point / delayed [cm]
     (1.0, 6.0, "band"),    # 0.26 / 0.27 / 0.12 (goals 2 / 2 / 1)
     (1.0, 6.0, "wiener"),  # 0.22 / 0.22 / 0.09
     (2.5, 9.0, "band"),    # 1.03 / 1.03 / 0.43 (goals 2 / 2 / 1)
@@ -308,15 +309,15 @@ def _errors(record, out, obs, settle=120.0):
     (1.0, 14.0, "wiener"),  # 1.54 / 1.54 / 0.53
     pytest.param(4.0, 14.0, "band", marks=pytest.mark.xfail(strict=True, reason=(
         "goal not met: measured 2.94 / 2.98 / 1.53 cm against 2.28 / 2.72 / 1.0; no causal estimator on this "
-        "IMU does better than about 2.4 cm at the IMU (paper003.causal_bound; README, paper 003)"))),
+        "IMU does better than about 2.4 cm at the IMU (paper003.causal_bound; docs/fmus/HeaveObserver.md)"))),
     pytest.param(4.0, 14.0, "wiener", marks=pytest.mark.xfail(strict=True, reason=(
         "goal not met: measured 2.69 / 2.76 / 1.19 cm against 2.28 / 2.72 / 1.0 (the causal bound: about 2.4 cm)"))),
 ])
 def test_heave_accuracy_meets_the_goal(hs, tp, model, record):
     """VesselMotion JONSWAP sea, default MEMS noise, 30 min after 2 min: real-time heave at the
     IMU and at a bow point 40 m away within max(2 cm, 2.5 % of the heave std), delayed heave
-    within max(1 cm, 1 %) (issue goals; commercial units state 5 cm or 5 %); the band observer
-    and the Wiener filter (model = "wiener")."""
+    within max(1 cm, 1 %) (the project's goals, beyond the 5 cm / 5 % of commercial MRUs); the
+    band observer and the Wiener filter (model = "wiener")."""
     rec = record if (hs, tp) == (1.0, 6.0) else _record(hs, tp)
     out, obs = _run(HeaveObserverParams(point=ARM, model=model), stack(rec, "imu.acc"), rec["truth.roll"],
                     rec["truth.pitch"])
@@ -361,11 +362,10 @@ def test_heave_response_explains_the_error_of_a_perfect_accelerometer():
     600 s spectrum, never re-estimated): the RMS error is sqrt(∫|H − 1|² S_z dω) of the truth's
     heave spectrum (measured 1.52 cm, predicted 1.47 cm with band_min 0.3; 1.55 / 1.48 cm with
     0.25, 1.83 / 1.76 cm with 0.35, which leaves more of the sea's low tail out; with the band
-    elements' variances read at one frequency instead of integrated, before 2026-11-23: 1.50 /
-    1.45, 1.51 / 1.46, 1.99 / 1.91 cm; a Welch
-    estimate of S_z over 1220 s in 819 s segments, coarser ones leak the peak below the band
-    where |H − 1| is large: 1.81 cm with 205 s; bound 10 %). The part of the Hs 4 / Tp 14 error
-    no better sensor removes (README)."""
+    elements' variances read at one frequency instead of integrated: 1.50 / 1.45, 1.51 / 1.46,
+    1.99 / 1.91 cm; a Welch estimate of S_z over 1220 s in 819 s segments, coarser ones leak the
+    peak below the band where |H − 1| is large: 1.81 cm with 205 s; bound 10 %). The part of the
+    Hs 4 / Tp 14 error no better sensor removes (docs/decisions/heave-gap-to-the-bound.md)."""
     from scipy import signal
 
     rec = dict(_record(4.0, 14.0))
@@ -383,9 +383,9 @@ def test_heave_response_explains_the_error_of_a_perfect_accelerometer():
 
 
 def test_causal_fir_bound_uses_only_the_past():
-    """The regression behind ``paper003.causal_bound`` (the README's causal bound): a target
-    that is a causal filter of the block means is fitted exactly (so rows and targets line up),
-    and one a block ahead of its input (a non-causal target) is not."""
+    """The regression behind ``paper003.causal_bound`` (docs/decisions/heave-causal-bound.md): a
+    target that is a causal filter of the block means is fitted exactly (so rows and targets line
+    up), and one a block ahead of its input (a non-causal target) is not."""
     rng = np.random.default_rng(11)
     a = rng.normal(size=4000)
     blocks = a.reshape(-1, 4).mean(axis=1)
@@ -427,9 +427,10 @@ def test_a_bias_step_in_mid_run_is_found_and_taken_out_by_the_wiener_filter(reco
     step 5 s later (:mod:`marinefmu.estimators.heave.bias_step`), takes it out of its window and of
     its filter's input, refines its size as it ages, and its heave is then the heave of the
     run without the step: measured 1.8 mm at most from 15 s after the step, 0.12 mm from 60 s;
-    the offset output has the step. The run without a step finds none. (Before: the step stayed in
-    the spectrum window, as a 1/ω² density, for 20 minutes: on Hs 2.5 / Tp 9, 59 cm RMS in
-    the second minute after it, 2.8 cm at 5-10 minutes; README, paper 003.)"""
+    the offset output has the step. The run without a step finds none. (Left in the spectrum
+    window, the step would stay there as a 1/ω² density for 20 minutes: on Hs 2.5 / Tp 9, 59 cm
+    RMS in the second minute after it, 2.8 cm at 5-10 minutes;
+    docs/decisions/heave-wiener.md.)"""
     n = int(600 / DT)
     acc = stack(record, "imu.acc")[:n]
     roll, pitch = record["truth.roll"][:n], record["truth.pitch"][:n]
@@ -511,8 +512,9 @@ def test_bad_parameters_are_refused_by_name(field, value, message):
 
 
 def test_highpass_baseline_has_the_analytic_response_and_refuses_a_bad_cutoff():
-    """The classical baseline beside the observer (README): its gain and phase on a sinusoid
-    are those of s²/B₄(s) (the bilinear transform warps ω by (ωΔt)²/12 = 8e-5 at ωΔt = 0.03)."""
+    """The classical baseline beside the observer (docs/fmus/HeaveObserver.md): its gain and
+    phase on a sinusoid are those of s²/B₄(s) (the bilinear transform warps ω by (ωΔt)²/12 =
+    8e-5 at ωΔt = 0.03)."""
     from scipy import signal
 
     from marinefmu.estimators.numerics import highpass_double_integration

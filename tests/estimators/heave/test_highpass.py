@@ -1,6 +1,6 @@
-"""The classical heave estimator sample by sample (OscillatorBankHeave model = "highpass", the
-baseline of issue 9): the same filter as the offline function, its stated response, its
-handling of bad samples and its parameters."""
+"""The classical heave estimator sample by sample (HeaveObserver model = "highpass", the
+baseline of the heave-compensation goals, docs/heave_compensation.md): the same filter as the
+offline function, its stated response, its handling of bad samples and its parameters."""
 import json
 import math
 

@@ -1,4 +1,4 @@
-"""The causal Wiener heave estimator (OscillatorBankHeave model = "wiener", beyond paper 003): its
+"""The causal Wiener heave estimator (HeaveObserver model = "wiener", beyond paper 003): its
 design against closed forms, the noise subtraction, a bias step, bad samples, state restore and
 the model switch. Accuracy against VesselMotion truth is in test_heave.py."""
 import math

@@ -96,7 +96,7 @@ def test_semisub_6dof_goals(noise, bounds):
     assert np.all(r["cog_rms_pct"] <= bounds), r["cog_rms_pct"]
     if not noise:
         assert np.all(r["attitude_rms_deg"][:2] < 0.001)  # gyro-only, noise-free: paper's setting
-    else:  # the goal, aided filter + post-processed refinement (measured 0.0061/0.0070)
+    else:  # the project's goal, aided filter + post-processed refinement (measured 0.0061/0.0070)
         assert np.all(r["attitude_rms_deg"][:2] <= 0.02), r["attitude_rms_deg"]
 
 
@@ -150,7 +150,8 @@ def test_sliding_window_centred_estimate_and_validity():
     truth = cog[20000 - 10000:len(cog) - 10000]
     err = centred - (truth - truth.mean(axis=0))
     rel = np.sqrt(np.mean(err ** 2, axis=0)) / truth.std(axis=0)
-    # measured 0.45 / 0.74 / 3.7 % on 600 s (README); 130 s scored here, each window zero-mean
+    # measured 0.45 / 0.74 / 3.7 % on 600 s (docs/fmus/DisplacementReconstructor.md); 130 s
+    # scored here, each window zero-mean
     assert np.all(rel < 0.05), rel
 
 
