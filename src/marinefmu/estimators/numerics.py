@@ -169,7 +169,8 @@ def highpass_double_integration(acc: np.ndarray, dt: float, cutoff: float, order
     discrete by the bilinear transform in second-order sections (:func:`highpass_sections`)
     and run by ``scipy.signal.sosfilt`` from rest. It has no drift, but its phase lead and gain
     loss near the cutoff are errors on long waves. The same filter runs sample by sample in
-    :class:`~.highpass_heave.HighpassHeave` (the HeaveObserver FMU's ``model = "highpass"``).
+    :class:`~marinefmu.estimators.heave.highpass.HighpassHeave` (the HeaveObserver FMU's
+    ``model = "highpass"``).
 
     Parameters
     ----------
@@ -197,15 +198,12 @@ def one_blas_thread():
     previous setting on exit.
 
     Used where an estimator multiplies small dense matrices every step or block: the
-    decomposition of :mod:`.reconstruction` and the covariance of :mod:`.aided_band`. The
-    decomposition's matrices are small (≈ 500 × 500 SVDs, 1000 × 120 least squares), and
-    OpenBLAS's thread synchronisation costs more than it gains on them: measured 2026-11-22
-    on this project's 2-core machine, one hour of 100 Hz three-axis acceleration took 14.9 s
-    with OpenBLAS's default two threads and 6.7 s with one (same results to 1e-12 m).
-    Running (segment, axis) fits in parallel Python threads instead gained nothing (7.7 s).
-    The aided coast's 60-220-state covariance products (above OpenBLAS's 64³ threading
-    threshold) took 190 µs per fusion step with one thread and 430-900 µs with two while
-    another process used the second core (2026-11-22)."""
+    decomposition of :mod:`~marinefmu.estimators.reconstruction.decomposition` and the
+    covariance of :mod:`~marinefmu.estimators.gnss_fusion.aided_band`. The decomposition's
+    matrices are small (≈ 500 × 500 SVDs, 1000 × 120 least squares) and the coast's
+    covariances 60-220 states (above OpenBLAS's 64³ threading threshold): on them OpenBLAS's
+    thread synchronisation costs more than a second thread gains, and far more when another
+    process holds the other core (docs/decisions/reconstruction-blas-threads.md)."""
     global _BLAS
     if _BLAS is None:
         _BLAS = ThreadpoolController()

@@ -7,7 +7,7 @@ Paper 000 integrates the body angular rate ω_b in the quaternion kinematics
     \\dot Q = \\tfrac12\\, Q ⊗ [0, ω_b]                      \\qquad (6, 7)
 
 and reads Euler angles from the quaternion (eqs. 8-9). Here ``Q`` represents R_nb (body → NED,
-DESIGN.md) and each step applies the **exact** rotation of the step instead of a first-order
+see the design page) and each step applies the **exact** rotation of the step instead of a first-order
 update of eq. 7: q_{k+1} = q_k ⊗ exp(½ ω̄ Δt), with ω̄ the mean of the two rate samples that
 bound the step (trapezoidal, second order in Δt), then normalised
 (:func:`integrate_gyro`). With any gyro bias b this drifts: the angle error grows as b·t.

@@ -2,7 +2,7 @@
 Zhang, Härting, Ntamba & Schwarz-Röhr).
 
 The CR is the point whose linear acceleration is not affected by the rotations. A sensor at
-offset ``o`` from the CR (here o = CR − sensor, body frame, DESIGN.md) reads the specific force
+offset ``o`` from the CR (here o = CR − sensor, body frame, see the design page) reads the specific force
 
 .. math::
     f_b = R_{nb}^T (a_{CR} - g_n) - (α × o + ω × (ω × o))
@@ -343,8 +343,8 @@ class CentreOfRotation:
     --------
     >>> est = CentreOfRotation(CentreOfRotationParams(diff_window=0.04))
     >>> r = est.step([0.0, 0.0, -9.80665], [0.0, 0.0, 0.0], 0.01)
-    >>> r.valid, r.delay     # filling the differentiation window
-    (False, 0.02)
+    >>> r.valid, r.delay     # filling the differentiation window (its shortest, 7 samples)
+    (False, 0.03)
     """
 
     def __init__(self, params: CentreOfRotationParams | None = None) -> None:

@@ -1,15 +1,14 @@
 """GNSS-aided band observer of one NED axis: the wave model of a GNSS dropout coast (beyond
 papers 001 and 003).
 
-Why. The coast of :mod:`.wave_coast` used to run the band observer of paper 003 on the
-acceleration alone and add a straight line fitted to the GNSS anchors z − d_w. That observer's
-wave displacement d_w was then only as good as the accelerometer makes it, all the time: on the
-paper-001 set-up its east error was 3.5 cm RMS (8 cm max) on a 57 cm sway *before* any gap,
-mostly from g × the antenna-attitude error at 0.1-0.3 rad/s, which the accelerometer cannot
-tell from sway. GNSS sees that displacement, but a line through the anchors could not give it
-back to the wave states. Applying the fixes to the band observer with its acceleration-only
-steady-state covariance did not work either (worse: the gain was wrong once positions are
-measured). The states need one covariance that knows both measurement types.
+Why. The band observer of paper 003, run on the acceleration alone, gives a wave displacement
+d_w only as good as the accelerometer makes it, all the time: on the paper-001 set-up its error
+is mostly g × the antenna-attitude error at 0.1-0.3 rad/s, which the accelerometer cannot tell
+from sway. GNSS sees that displacement, but a straight line fitted to the GNSS anchors z − d_w
+cannot give it back to the wave states, and applying the fixes to the band observer with its
+acceleration-only steady-state covariance makes the gain wrong once positions are measured.
+The states need one covariance that knows both measurement types
+(docs/decisions/gnss-fusion-coast.md).
 
 Model. One Kalman filter with the state
 
@@ -36,101 +35,48 @@ covariance, it *is* that observer (a test checks the states to 1e-9).
 
 Written out rather than with filterpy's ``KalmanFilter``: every measurement here is a scalar,
 for which the plain update K = P hᵀ/s, P ← P − s K Kᵀ costs O(n²), and filterpy's Joseph-form
-update O(n³) (n ≈ 60-220): the fusion of the 340 s dropout record below took about 6.5 s with
-filterpy's filter and 5 s written out (4 s with the line coast before). A test runs the same
-sequence through a filterpy ``KalmanFilter`` and compares.
+update O(n³) (n ≈ 60-220). A test runs the same sequence through a filterpy ``KalmanFilter``
+and compares.
 
 When the band observer's spectrum changes the element set (every
 :data:`~.wave_coast.PEAK_INTERVAL` s), state and covariance are carried by
 :func:`~.oscillator_bank.carry_map` (P ← T P Tᵀ); an element with no predecessor starts from the
-new model's steady-state covariance, uncorrelated with the rest. Two alternatives were worse on
-east (30 dropouts below): the new model's steady-state covariance for the whole band (what the
-fixes told is lost when the change falls at the start of a gap), and that covariance less the
-carried reduction the fixes made.
+new model's steady-state covariance, uncorrelated with the rest. Two alternatives coasted worse
+on east: the new model's steady-state covariance for the whole band (what the fixes told is
+lost when the change falls at the start of a gap), and that covariance less the carried
+reduction the fixes made.
 
-Measured without the tilt states below (``coast_tilt`` false) on the paper-001 set-up (1 Hz
-RTK, a 30 s dropout, max error through the gap of the fused real-time output; the coast's
-acceleration corrected with its own attitude (``coast_attitude_tau`` 150 s of :class:`~.gnss_fusion.GnssAccFusionParams`), spectrum window
-:data:`~.wave_coast.SPECTRUM_WINDOW` 180 s, the step means of :meth:`WaveCoast.add
-<.wave_coast.WaveCoast.add>`; ``make bench``, part ``dropout``, 2026-11-24; in brackets before
-the step-mean fix of that day, then the fusion's attitude and a 120 s window):
-
-* dropout at 300 s (the test's), seeds 1-10: east 6.7 / 4.1 / 7.7 / 7.4 / 5.8 / 8.0 / 6.0 /
-  5.7 / 7.2 / 4.8 cm (7.5 / 3.6 / 9.6 / 8.1 / 6.0 / 7.5 / 6.4 / 5.5 / 9.5 / 4.4; 8.4 / 4.7 /
-  8.4 / 9.4 / 6.2 / 5.7 / 7.5 / 6.1 / 9.0 / 5.7), against 8.4 / 3.8 / 11.2 / 12.0 / 6.0 / 7.9 /
-  9.5 / 10.3 / 8.2 / 8.1 cm with the line through the anchors; north at most 5.7 cm, down at
-  most 5.3 cm (6.5; 8.0; line: 5.7 and 6.0 cm);
-* 60 dropouts, at 270, 300 and 320 s of seeds 1-10, at 400 s of seeds 11-20 and at 350 s of
-  seeds 21-40: east at 10 cm or more in 4 (worst 15.4 cm, seed 27 at 350 s), mean N / E / D
-  1.9 / 6.6 / 3.1 cm (3, 17.1 cm, 1.9 / 7.1 / 4.3 cm); the line: 12 of the first 30 (at most
-  14.6 cm). The best linear estimator that knows the joint statistics of the sea and the
-  sensors errs far less on the same dropouts (:mod:`marinefmu.papers.gap_bound`).
-
-Tilt states (2026-11-24, :class:`Tilt`, ``coast_tilt`` of
-:class:`~.gnss_fusion.GnssAccFusionParams`). The horizontal acceleration is off by g × the error of
-the attitude that corrects it, ε: east by −g·ε_N, north by +g·ε_E (checked on the paper-001
-record: the 20 s means of a_used − a_true equal g·ε to 0.5 mm/s², with ε 1-4 mrad and the
-accelerometer bias under 1 mm/s²). Until then a loose random-walk offset
-(:data:`~.wave_coast.HORIZONTAL_OFFSET_NOISE`, ten times the heave observer's) stood in for
-g·ε, and took a few percent of the sway at the wave peak with it (|1 − H| 3 % at 0.77 rad/s).
-Now the north and east filters carry ε and the gyro-bias error δ that turns it,
+Tilt states (:class:`Tilt`, ``coast_tilt`` of :class:`~.filter.GnssAccFusionParams`). The
+horizontal acceleration is off by g × the error of the attitude that corrects it, ε: east by
+−g·ε_N, north by +g·ε_E (checked on the paper-001 record). Without tilt states a loose
+random-walk offset (:data:`~.wave_coast.HORIZONTAL_OFFSET_NOISE`, ten times the heave
+observer's) stands in for g·ε, and takes a few percent of the sway at the wave peak with it.
+With them the north and east filters carry ε and the gyro-bias error δ that turns it,
 
     ε̇ = δ + w,  δ Gauss-Markov (the gyro's bias instability and correlation time),
-    w white (the gyro's white noise, its angle random walk; ARW below),
+    w white (the gyro's white noise, its angle random walk, of density ``noise``),
 
 with ``gain``·ε in the acceleration row (and −J·gain in Ā, the increment form's feed-through),
 measured at every fix by the antenna attitude's error against the coast's attitude (σ from the
-antenna geometry, :func:`~.antenna_attitude.antenna_attitude_std`: 1.9 / 0.75 mrad about N / E on
-the paper-001 set-up, as measured). The coast's PI pulls move ε and δ by known amounts
-(:meth:`AidedBand.shift_tilt`). The offset keeps the heave observer's noise (1e-4), the
-accelerometer bias alone; at the first band model it restarts at 0 ± 2 mm/s², because the
-observer's own offset had taken g·ε (started on it, ε was estimated 1.5 mrad off on seed 27;
-restarted, 0.24 / 0.15 mrad RMS about N / E over 190 s, with the 1.3 → 4.2 mrad growth of ε_N
-through the gap followed to 0.5 mrad). On a synthetic tilt swing the gap error falls from
-9.1-9.3 to 4.8-5.6 cm (test). Over the 60 dropouts (``make bench``, part ``dropout``,
-2026-11-24): east at 10 cm or more in 2 instead of 4 (seed 27 at 350 s 11.8 cm instead of
-15.4, seed 36 10.8 instead of 8.0), mean N / E / D 2.0 / 6.6 / 3.1 cm (1.9 / 6.6 / 3.1).
-Scans: with an offset noise of 3e-4 also 2 (12.2 cm worst, mean east 6.6 cm);
-``gyro_bias_sigma`` 1e-4, 3; ``coast_attitude_tau`` 50 s, 3 (13.1 cm). With the tilt states the
-band observers' spectrum counts too: with the heave observer's own settings (a growing window,
-integrated variances; :mod:`.wave_coast`) 1 of the 60 (10.7 cm, seed 27), mean N / E / D
-2.0 / 6.3 / 3.0 cm; with the element weights smoothed over neighbours
-(:data:`~.wave_coast.BAND_SMOOTHING`) none (worst 9.7 cm), mean 2.0 / 6.1 / 2.9 cm, but 1 of the
-same 60 later in a run (10.4 cm, seed 2 at 1200 s) (``make bench``, part ``dropout``,
-2026-11-24).
+antenna geometry, :func:`~.antenna_attitude.antenna_attitude_std`). The coast's PI pulls move ε
+and δ by known amounts (:meth:`AidedBand.shift_tilt`). The offset keeps the heave observer's
+noise (1e-4), the accelerometer bias alone; at the first band model it restarts at
+0 ± 2 mm/s², because the observer's own offset holds g·ε as well, and kept, it would hide ε
+from the tilt states. The angle random walk in Q makes the tilt estimate err what its
+covariance says (a test checks this on a synthetic tilt that walks). The band observers'
+spectrum counts with the tilt states: they take the heave observer's own spectrum settings
+(:mod:`.wave_coast`).
 
-ARW (session 32, 2026-11-24): the coast's attitude integrates the gyro's white noise too, a
-random walk of ε of density ``noise`` (:class:`Tilt`, the fusion's ``gyro_noise``), which
-the tilt states used to leave out (Q on ε zero). With it, on a synthetic tilt that walks at
-5e-4 rad/s/√Hz, the tilt estimate errs what its covariance says (RMS / σ 0.74-1.01 over ten
-seeds, against 4.0-8.7 without) and the gap error falls from 14-54 to 9-14 cm (test). On the
-paper-001 set-up (scans): over 200 fresh 30 s dropouts east reaches 10 cm in 1 instead of 3,
-mean 5.78 cm instead of 5.87, 95th percentile 8.1 cm instead of 8.3; with a gyro of 1e-5
-rad/s bias instability and the MEMS white noise seed 27 at 350 s errs 10.1 cm instead of
-12.2, with a tactical-grade gyro 8.3 instead of 8.5 cm. On the 60 early bench dropouts the
-mean east falls 6.06 → 5.90 cm, but seed 27 at 350 s rises 9.7 → 10.7 cm: the tail moves,
-as with every change here.
+Wave tilt (:meth:`AidedBand.follow_angle`, :meth:`AidedBand.wave_tilt`; :mod:`.wave_coast`,
+"The wave tilt"): the correcting attitude's own tilt, the vessel's wave roll or pitch less ε,
+measured at every band step through a band model of the wave tilt that sits after the tilt
+states. It is a second measurement of ε that goes on in a gap (a test shows the gain on a
+synthetic swing with the MEMS gyro's angle random walk).
 
-Wave tilt (session 33, 2026-11-24, :meth:`AidedBand.follow_angle`, :meth:`AidedBand.wave_tilt`;
-:mod:`.wave_coast`, "The wave tilt"): the correcting attitude's own tilt, the vessel's wave
-roll or pitch less ε, measured at every band step through a band model of the wave tilt that
-sits after the tilt states. It is a second measurement of ε that goes on in a gap. On the
-synthetic swing with the MEMS gyro's angle random walk the gap error falls from 6.3 to 4.6 cm
-on average (test); on the paper-001 set-up see :mod:`.wave_coast`.
-
-What is left on east is at the wave frequency: through seed 27's gap the error swung ±9 cm
-at the 8 s peak period on a ±1.5 m sway (±4 cm with the true attitude; before the spectrum
-settings). What tells the sway
-in a gap beyond the acceleration is the roll the gyro measures
-(:mod:`marinefmu.papers.gap_bound`); this filter does not use it. Split by input (the filter
-replayed with one input real and the others true, 2026-11-24, README): the true tilt that the
-tilt states must follow through the gap is the largest part on seeds 3 and 10 (2.6 cm RMS),
-and with every input true the tilt states cost 1.3 → 3.0 cm RMS on seed 27: in a gap they
-follow ε with a bandwidth of about 0.37 rad/s, so what the band model misses at the wave peak
-partly lands in ε. Measured and not taken
-before the tilt states: lower offset noise, an offset-rate state, another offset noise in gaps
-only, a smoothed spectrum, and the fixes' attitude as a measurement of the offset itself
-(``docs/paper001_dropout.md``).
+What is left on east is at the wave frequency. What tells the sway in a gap beyond the
+acceleration is the roll the gyro measures (:mod:`marinefmu.papers.gap_bound`); this filter
+does not use it. The measurements behind each choice, and what was tried and not kept, are in
+docs/decisions/gnss-fusion-coast.md.
 """
 from __future__ import annotations
 
@@ -165,17 +111,14 @@ class Tilt:
 
 #: Standard deviation of a GNSS position of the accelerometer point, per axis [m]. Four RTK
 #: antennas (1 cm) average to 0.5 cm, and the lever arm turned with the propagated attitude adds
-#: its share; of 0.5, 1, 2 and 5 cm, 2 cm coasted best (max east error through the dropout of
-#: seeds 1-3: 9.2 / 5.6 / 8.5, 8.9 / 5.1 / 8.5, 8.4 / 4.8 / 8.4, 8.4 / 4.5 / 8.7 cm).
+#: its share; 2 cm, above that, coasted best of 0.5-5 cm (docs/decisions/gnss-fusion-coast.md).
 FIX_SIGMA = 0.02
 #: Prior standard deviations of the drift position [m] and velocity [m/s] at a (re)start.
 DRIFT_PRIOR = (10.0, 1.0)
 #: Standard deviation of the correcting attitude's own tilt as a measurement of the wave-tilt
-#: band less ε [rad] (:meth:`AidedBand.wave_tilt`). The angle itself is exact to 1e-6 rad RMS
-#: (the split θ_used = θ − ε, checked about N on the paper-001 record); this allows for the
-#: band model's misfit of a narrow roll spectrum. Scans on three of the hardest 30 s dropouts
-#: (max east error, seeds 27 / 120 / 54, 2026-11-24): 1e-4 11.3 / 8.1 / 10.3 cm, 1e-3 10.1 / 9.2 / 10.3 cm,
-#: 3e-3 10.3 / 9.6 / 10.7 cm (damping 0.1; without the band 10.7 / 10.1 / 10.9 cm).
+#: band less ε [rad] (:meth:`AidedBand.wave_tilt`). The angle itself is nearly exact (the
+#: split θ_used = θ − ε); this allows for the band model's misfit of a narrow roll spectrum
+#: (docs/decisions/gnss-fusion-coast.md).
 ANGLE_SIGMA = 1e-3
 
 
@@ -362,11 +305,10 @@ class AidedBand:
         model the drift is only predicted).
 
         ``y`` must be the mean over *this* step (:meth:`~.wave_coast.WaveCoast.add` gives the
-        trapezoid mean of the accelerometer's point samples). Until 2026-11-24 this method
-        averaged its argument, a block mean of five 100 Hz samples, with the previous one, as
-        the heave observer does with point samples: the band states then lagged 20 ms more
-        (measured on a sine: 31.4 ms against the model's own 11.4 ms; 1.6 % of the sway at
-        0.8 rad/s), half of the coast's error with perfect sensors (``docs/paper001_dropout.md``).
+        trapezoid mean of the accelerometer's point samples). Averaging a block mean again with
+        the previous one, as the heave observer does with point samples, would make the band
+        states lag by a further fraction of a step, a large share of the coast's error with
+        perfect sensors (docs/decisions/gnss-fusion-coast.md).
         """
         if self.model is None:
             self._predict(0.0)
@@ -442,8 +384,7 @@ class AidedBand:
         With a wave-tilt band F is block-diagonal, [F₁ 0; 0 F₂], and F₂ is itself a chain of
         independent elements (``angle.block`` states each), so the product is taken by parts
         and F₂'s by element (:func:`blocks_times`): O(n₁³ + n₁²n₂ + n₂²·block) instead of
-        O((n₁ + n₂)³): over a 390 s paper-001 record (n₁ 95-113, n₂ 78-198) the predictions
-        took 2.3 s instead of 12.2 s (a profile, 2026-11-24)."""
+        O((n₁ + n₂)³) (n₁ about 100, n₂ up to about 200 on the paper-001 set-up)."""
         self.x = self.F @ self.x + self.J * y
         if self.angle is None:
             p = self.F @ self.P @ self.F.T + self.Q

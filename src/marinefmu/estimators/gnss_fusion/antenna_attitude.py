@@ -1,5 +1,5 @@
 """Attitude and position from four GNSS antennas (paper 001, item 1 of
-:mod:`.gnss_fusion`): the least-squares attitude of Wahba's problem and its error.
+:mod:`.filter`): the least-squares attitude of Wahba's problem and its error.
 
 The four measured antenna positions p_i (NED) and their body lever arms l_i relative to the
 COG satisfy p_i = p_c + R_nb l_i. The least-squares R_nb is Wahba's problem on the centred

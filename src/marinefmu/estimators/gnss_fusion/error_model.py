@@ -3,8 +3,8 @@ fixes (beyond paper 001).
 
 Why. The fusion filter's own covariance P is that of its model, q and r of eqs. 16-17. Those
 set the blend (the gain depends on q/r only), not the size of the errors: on the paper-001
-set-up (1 Hz RTK) P saw-tooths 3.0-8.5 cm between fixes while the error is 0.7 cm; error /
-``pos_std`` had an RMS of 0.14 (seeds 1-3, 100-300 s). A ``pos_std`` that a user can weigh
+set-up (1 Hz RTK) P is several times the error the filter makes
+(docs/decisions/gnss-fusion-pos-std.md). A ``pos_std`` that a user can weigh
 needs the covariance of the error the filter actually makes. This module keeps it alongside
 the filter, without changing the fused output:
 
@@ -21,7 +21,7 @@ kept at the accelerometer rate:
 2. **The attitude error**, states (ε, β, b) — the attitude error (true R = exp([ε]×) R̂), the
    gyro-bias error and the true Gauss-Markov bias (``gyro_bias_sigma``, ``gyro_bias_tau``) —
    driven by the gyro's angle random walk ``gyro_noise`` and pulled at each fix with the PI
-   loop's gains (:func:`~.gnss_fusion.pi_pull`) and the fix attitude's noise
+   loop's gains (:func:`~.filter.pi_pull`) and the fix attitude's noise
    (:func:`~.antenna_attitude.antenna_attitude_std`).
 
    With ``propagation="hold"`` the attitude is the last fix's, and its error is that fix's
@@ -30,16 +30,11 @@ kept at the accelerometer rate:
    (β, b). Its covariance is measured from fix to fix (:meth:`FusionError.held_rotation`: the
    rotation between consecutive fixes' attitudes, less their noise). Each fix resets ε to ε⁺,
    which is also what the fix's accelerometer point carries over its arm (:meth:`FusionError.fix`),
-   so the output's share of ε⁺ is over the short arm from the antennas' centroid. Until
-   2026-11-24 (session 27) ε was ε⁺ alone, held constant: on the paper-001 set-up at 1 Hz
-   (seeds 1-3, 100-300 s, a scan) error / ``pos_std`` was 0.96-1.09 / 1.13-1.27 / 1.43-1.70
-   N / E / D, over-confident, the consistency check (step 4) covering part of the rotation's
-   effect; now 0.91-1.03 / 1.04-1.13 / 0.98-1.09 (``make bench``, part ``pos_std``).
-   East depends on :data:`HOLD_RATE_TAU` (seeds 1-2, a scan): 0.84-0.91 with 0.7 s, 0.95-1.03
-   with 1.3 s (about 1/ω_p of the Tp 8 s sea), 1.04-1.13 with 2 s, 1.20-1.31 with 4 s,
-   1.36-1.50 with 10 s. 2 s is kept for longer seas too: near the roll resonance (Tp 12 s,
-   roll 4.6° RMS) seed 1 reads 0.91 / 0.77 / 0.88, east 0.69 with 1.3 s and 0.92 with 4 s.
-   Once a fix is overdue the fusion follows its coast's gyro attitude (:mod:`.gnss_fusion`);
+   so the output's share of ε⁺ is over the short arm from the antennas' centroid. With ε⁺
+   alone, held constant, ``pos_std`` is over-confident. :data:`HOLD_RATE_TAU` is a little
+   longer than 1/ω_p of the paper-001 sea, so that it also serves longer seas near the roll
+   resonance (docs/decisions/gnss-fusion-pos-std.md).
+   Once a fix is overdue the fusion follows its coast's gyro attitude (:mod:`.filter`);
    this model still takes the attitude as held, so it is cautious then, and in a gap
    ``pos_std`` is the coast's anyway.
 3. **How the two go together** (the reason for one covariance). An attitude error moves
@@ -48,11 +43,10 @@ kept at the accelerometer rate:
    of a fix, z = centroid + R̂ (l − c̄) (l the accelerometer's arm, c̄ the antennas' mean arm),
    by S ε with S = [R̂ (l − c̄)]×, so the innovation is ν = −H e + S ε + n_c, and (c) the COG
    output x − R̂ l by −[R̂ l]× ε. The filter follows (a) and (b), so the output's error is
-   e_pos − [R̂ l]× ε with e_pos and ε correlated: on the paper-001 set-up the correlation of
-   the east error with ε_N is 0.37 in the model and 0.23-0.43 in simulation (seeds 1-6,
-   100-300 s, a scan). Until session 26 (2026-11-24) the attitude's share, ε × (R c̄), was
-   added to the position variance as independent, which left ``pos_std`` cautious (east
-   error / ``pos_std`` 0.72-0.88, and 0.66 for a minute after a gap).
+   e_pos − [R̂ l]× ε with e_pos and ε correlated (on the paper-001 set-up the model's
+   correlation of the east error with ε_N matches the simulation's). The attitude's share,
+   ε × (R c̄), added to the position variance as independent would leave ``pos_std``
+   cautious, most of all just after a gap (docs/decisions/gnss-fusion-pos-std.md).
 4. **A consistency check** (covariance matching: Mehra 1972; Myers & Tapley 1976): at each fix
    the innovation's square over its predicted variance, r = ν²/(M P Mᵀ + R_t) with
    M = [−H, S, 0], is 1 on average when the model holds. Per axis the acceleration noise
@@ -60,16 +54,10 @@ kept at the accelerometer rate:
    below the sensor's: an acceleration worse than its datasheet (the uncorrected acceleration
    of the paper's "before" case) shows in the innovations, and the covariance follows.
 
-Measured (``make bench``, part ``pos_std``, 2026-11-24, the README's table; 100-300 s without a
-gap, error / ``pos_std`` RMS per seed N / E / D; 1 is calibrated): paper-001 set-up at 1 Hz,
-seeds 1-10, 0.89-1.07 / 0.88-1.07 / 0.93-1.04; at 10 Hz (seeds 1-3) 0.76-0.98 / 0.80-1.11 /
-0.98-1.01; the buoy of experiment (c) at 1 Hz 0.76-1.37 / 0.76-1.12 / 0.97-1.05 (its 15 mrad
-fix attitude makes the slow attitude error the largest term, and seed 3's 1.37 north is a
-pitch error of 9.5 mrad for 20 s, 3.3 times the loop's std: the loop's error over 200 s is
-some seven independent samples); the uncorrected acceleration (east 14 cm RMS) 0.84-0.96 /
-1.05-1.15 / 1.12-1.37 (without step 4: 14 east, a scan). In the 5-50 s after a 30 s gap,
-east 0.91 (seeds 1-20, a scan; 0.66 before session 26).
-In a GNSS gap bridged by the wave coast ``pos_std`` is the coast's (:mod:`.gnss_fusion`); this
+How well ``pos_std`` is calibrated (error / ``pos_std``, 1 is calibrated) is measured by
+``make bench``, part ``pos_std`` (the benchmarks page; the history in
+docs/decisions/gnss-fusion-pos-std.md).
+In a GNSS gap bridged by the wave coast ``pos_std`` is the coast's (:mod:`.filter`); this
 covariance then follows the filter's (its correlation with the attitude dropped), and the
 fixes after the gap bring it down again.
 
@@ -96,7 +84,7 @@ HOLD_RATE_MEMORY = 60.0
 
 
 def pi_gains(interval: float, tau: float) -> tuple[float, float]:
-    """Gains of the PI attitude loop (:func:`~.gnss_fusion.pi_pull`) for a fix ``interval`` s
+    """Gains of the PI attitude loop (:func:`~.filter.pi_pull`) for a fix ``interval`` s
     after the previous one, time constant ``tau`` [s]: the proportional fraction k_p·Δt with
     k_p = 2/τ, at most 1, and the integral gain k_i·Δt = Δt/τ², capped at 1/Δt after a gap
     longer than τ: e/Δt is then the whole bias error that built the attitude error e (after a
@@ -244,7 +232,7 @@ class FusionError:
     def set_model(self, f: np.ndarray, g: np.ndarray, q_acc: np.ndarray, q_bias: np.ndarray, dt: float) -> None:
         """The model for the step size ``dt`` [s] in use: the filter's Φ ``f`` and input matrix
         ``g`` (eq. 15), ``q_acc`` eq. 16's Q with the density :attr:`q_true`
-        (:func:`~.gnss_fusion.process_noise`), which the consistency check scales per axis, and
+        (:func:`~.filter.process_noise`), which the consistency check scales per axis, and
         ``q_bias`` the bias states' part."""
         self.model_args = (f, g, q_acc, q_bias, dt)
         a, q_loop = loop_transition(dt, self.bias_sigma, self.bias_tau, self.gyro_noise, self.attitude_tau is not None,

@@ -1,6 +1,6 @@
 """Multi-antenna GNSS + accelerometer fusion with attitude correction (paper 001).
 
-Frames: the paper works in ENU with z up; here everything is NED/FRD (DESIGN.md) — positions
+Frames: the paper works in ENU with z up; here everything is NED/FRD (see the design page) — positions
 north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +g].
 
 1. **Attitude from the antennas** (:mod:`.antenna_attitude`): the least-squares attitude
@@ -20,9 +20,8 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    through GNSS dropouts. ``propagation="hold"`` uses the latest fix's attitude until the next
    (the causal form of the paper's interpolation; no gyro needed). Once a fix is overdue
    (:data:`HOLD_OVERDUE` times the usual interval) and a gyro is given, it takes the wave
-   coast's gyro attitude until the next fix: a held attitude is stale in a gap (through the
-   30 s dropout of the README, seed 1, it left east 5.7 m off; now 8.2 cm from 1.5 s in,
-   against 6.1 cm with ``"gyro"``). Without a gyro (or with ``coast="inertial"``, which keeps
+   coast's gyro attitude until the next fix: a held attitude is stale in a gap (metres of east
+   error through a 30 s dropout). Without a gyro (or with ``coast="inertial"``, which keeps
    no gyro attitude) nothing follows the attitude in a gap: ``valid`` is false while a fix is
    overdue.
 3. **Kalman fusion** (filterpy ``KalmanFilter``): per axis the constant-acceleration model of
@@ -34,24 +33,22 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    eq. 15 with a_k): a held sample makes the predicted velocity err by (Δt/2)·a(t) and the
    attitude by (Δt/2)·ω(t), oscillations (±5 mm/s at 1 m/s², ±0.01° at 0.04 rad/s, 100 Hz)
    that the GNSS updates cannot see but that turn into drift the moment GNSS drops out
-   (perfect sensors, 1 Hz GNSS, 30 s dropout: 17 cm east and 13 cm down with ``"latest"``,
-   see the tests). The fused point is the
+   (decimetres through a 30 s dropout with perfect sensors and ``"latest"``, see the tests).
+   The fused point is the
    accelerometer (the GNSS measurement of it is p_c + R l_acc), so no lever-arm acceleration
    terms are needed; the outputs are transferred to the COG.
    Beyond the paper: an n-frame accelerometer-bias state per axis (``bias_states``; random
    walk of density ``bias_rw``), which also absorbs slowly varying tilt errors; a Mahalanobis
    gate on the 3-D innovation (``gate`` in σ) that rejects jumps and outliers, its variance
    per axis the filter's own or, where larger, the one the error covariance of
-   :mod:`.fusion_error` predicts (with a held attitude the filter's own does not know the
-   vessel's rotation since the fix: near the roll resonance, Tp 12 s on the paper-001
-   set-up, it rejected 58 of 301 fixes and the output drifted to 8 m; now none, east 10 cm
-   RMS; the default gyro mode's output was bit-identical on the three dropout runs checked,
-   2026-11-24); coasting
+   :mod:`.error_model` predicts (with a held attitude the filter's own does not know the
+   vessel's rotation since the fix, and near the roll resonance it would reject good fixes;
+   docs/decisions/gnss-fusion-filter.md); coasting
    through dropouts (item 4), with ``valid`` false after ``max_coast`` s;
    re-initialisation on GNSS after ``reinit_time`` s of consecutive rejections (a real
    reposition, not a glitch) and on the first fix after a gap longer than ``max_coast`` (with
    the velocity the wave coast held, when it bridged the gap); and
-   an RTS fixed-interval smoother for post-processing (:func:`~.fusion_runs.fuse`,
+   an RTS fixed-interval smoother for post-processing (:func:`~.runs.fuse`,
    ``smooth=True``; hand-written because filterpy's ``rts_smoother`` has no control input,
    and here x⁻_{k+1} = Φ x_k + G u_k).
 4. **Coasting through GNSS dropouts** (``coast``, beyond the paper). ``"inertial"`` predicts
@@ -66,22 +63,19 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    ``coast_tilt``) updates the filter every
    :data:`COAST_INTERVAL` s as a pseudo-fix (not gated; ``fix`` is ``"wave"``) of variance
    ``coast_sigma``² plus the coast's own (which grows through the gap), until GNSS returns,
-   however long the gap: on the paper's set-up a 5-min gap errs 23 cm at most (seeds 1-4),
-   where the inertial coast is kilometres off. The coast's variance goes back into the
+   however long the gap: on the paper's set-up a 5-min gap errs decimetres, where the
+   inertial coast is kilometres off. The coast's variance goes back into the
    filter's covariance before the next fix is gated. In the gap ``pos_std`` is the coast's own
    standard deviation combined with the running RMS of the pseudo-fix innovations (how far the
    output strays from the coast between pseudo-fixes, :data:`TRACK_WEIGHT`), not the filter's:
-   the filter takes the pseudo-fixes as independent and its covariance settles near 6.5 cm
-   whatever the error. Over the 60 dropouts of :mod:`.aided_band` (``make bench``, part
-   ``dropout``, 2026-11-24), error over ``pos_std`` in the gap: RMS 0.52 / 0.90 / 0.85 N / E / D,
-   beyond 2 in 0.0 / 2.5 / 1.8 % of the time (Gaussian: 4.6 %); with the filter's covariance
-   plus the coast's, as until then, 0.12 / 0.40 / 0.22 and never (a scan; mean ``pos_std``
-   6.4 / 6.9 / 6.5 cm on RMS errors of 0.8 / 2.7 / 1.4 cm). Between fixes ``pos_std`` is not
-   the filter's covariance either, whose q and r set the blend but not the size of the errors,
-   but that of the error the filter makes as it runs (:mod:`.fusion_error`). Without a coast
-   position for ``max_coast`` s (``"inertial"``, or a gap in the coast's first 3 minutes) the
-   filter holds its position (velocity zero) until GNSS returns. Measured on the paper's
-   set-up (1 Hz, 30 s dropout, seeds 1-3): see the README.
+   the filter takes the pseudo-fixes as independent and its covariance settles at a few
+   centimetres whatever the error, far too cautious (docs/decisions/gnss-fusion-filter.md).
+   Between fixes ``pos_std`` is not the filter's covariance either, whose q and r set the
+   blend but not the size of the errors, but that of the error the filter makes as it runs
+   (:mod:`.error_model`). Without a coast position for ``max_coast`` s (``"inertial"``, or a
+   gap in the coast's first 3 minutes) the filter holds its position (velocity zero) until
+   GNSS returns. The accuracy through dropouts is measured by ``make bench``, part
+   ``dropout`` (the benchmarks page).
 """
 from __future__ import annotations
 
@@ -108,12 +102,10 @@ STEP_INPUT_CHOICES = ("mean", "latest")
 COAST_CHOICES = ("band", "inertial")
 #: With ``coast="band"``, pseudo-fixes start this long [s] after the last accepted fix ...
 COAST_AFTER = 2.0
-#: ... and follow each other at this interval [s]. Measured max east error through the 30 s
-#: dropout of seeds 1 / 2 / 3 (README): 10.6 / 7.4 / 13.6 cm at 1 s (``coast_sigma`` 5 cm),
-#: 7.1 / 5.6 / 11.4 cm at 0.1 s, no better at 0.05 s (the fused output then follows the coast,
-#: whose own error is what is left); another ``coast_sigma`` at 1 s does not do it (2 or 15 cm:
-#: 12.0-13.6 cm on seed 3). At 0.1 s the default ``coast_sigma`` is 15 cm, the information
-#: per second of 5 cm once a second: 7.0 / 4.9 / 11.5 cm real time, RTS 4.9 / 3.5 / 9.4 cm.
+#: ... and follow each other at this interval [s]: often enough that the fused output follows
+#: the coast, whose own error is then what is left (more often gains nothing). At 0.1 s the
+#: default ``coast_sigma`` is 15 cm, the information per second of 5 cm once a second
+#: (docs/decisions/gnss-fusion-filter.md).
 COAST_INTERVAL = 0.1
 #: With ``propagation="hold"`` a fix is overdue once this many times the usual interval between
 #: accepted fixes has passed without one; the attitude then follows the coast's gyro attitude
@@ -145,10 +137,10 @@ class GnssAccFusionParams:
         axis can trust the accelerometer more. [``q_down``]
     r : float
         GNSS position noise of eq. 17, R = r/Δt [m²·s], > 0. The defaults q = 0.005,
-        r = 1e-5 (at Δt = 0.01 s, R = (3 cm)²) were the best of a 3 × 3 grid on experiment (b)
-        of :mod:`marinefmu.papers.paper001` (1 Hz RTK, 300 s): RMS 0.66 / 0.74 / 1.0 cm;
-        the ratio q/r sets the blend, and r = σ²Δt (R = σ²) weights 1 Hz fixes too much
-        against 100 Hz predictions. [``r``]
+        r = 1e-5 (at Δt = 0.01 s, R = (3 cm)²) are the best of a 3 × 3 grid on experiment (b)
+        of :mod:`marinefmu.papers.paper001` (1 Hz RTK, 300 s;
+        docs/decisions/gnss-fusion-filter.md): the ratio q/r sets the blend, and r = σ²Δt
+        (R = σ²) weights 1 Hz fixes too much against 100 Hz predictions. [``r``]
     attitude_correction : bool
         Rotate the specific force with the attitude (True) or take the sensor axes as NED
         (the paper's uncorrected case). [``attitude_correction``]
@@ -187,54 +179,49 @@ class GnssAccFusionParams:
         the attitude correction and a gyro). The coast's acceleration is corrected with an attitude
         propagated by the same gyro but pulled to the fixes more slowly than the fusion's
         (``attitude_tau``): its horizontal offset takes a slowly wandering tilt, while the fix
-        noise a fast PI lets through sits nearer the waves. Max east error through a 30 s
-        dropout at 1 Hz (paper-001 set-up, 40 dropouts: 270 / 300 / 320 s × seeds 1-10 and
-        400 s × seeds 11-20): over 10 cm in 5 with the fusion's 30 s (mean 7.3 cm, worst
-        13.7 cm), 2 with 60 s and 90 s, 1 with 150 s (6.8 cm, 10.6 cm), 300 s (6.8 cm, 10.1 cm)
-        and 1000 s (6.9 cm, 10.7 cm). The fusion's own 60 s would coast as well but
-        makes the fused output worse all the time (``docs/paper001_dropout.md``). [``coast_attitude_tau``]
+        noise a fast PI lets through sits nearer the waves. Through 30 s dropouts the coast
+        gains from a slow pull up to about 150 s and no more beyond; a fusion as slow would
+        coast as well but makes the fused output worse all the time
+        (docs/decisions/gnss-fusion-filter.md). [``coast_attitude_tau``]
     coast_window : float
         Memory of the drift model of ``coast="band"`` (:func:`~.aided_band.drift_noise`) [s],
-        10 … 3600. The coast gives pseudo-fixes until GNSS returns, however long the gap (until
-        2026-11-23 only for ``coast_window`` s, then the inertial coast took over and was
-        1.6 km off after a 5-min gap). It has no position before its spectrum window
+        10 … 3600. The coast gives pseudo-fixes until GNSS returns, however long the gap. It
+        has no position before its spectrum window
         (:data:`~.wave_coast.SPECTRUM_WINDOW`, 180 s) has passed. [``coast_window``]
     coast_tilt : bool
         Give the coast's north and east filters two tilt-error states (the error of the coast's
         attitude about E / N and the gyro-bias error that turns it), measured by each fix's
         antenna attitude (:class:`~.aided_band.Tilt`); their offset then takes only the
-        accelerometer bias. False: a loose offset stands in for the tilt (until 2026-11-24).
-        Needs ``coast="band"``, the attitude correction and a gyro. Over the
-        60 dropouts of the README (paper 001): east at 10 cm or more in 2 instead of 4, worst
-        11.8 cm instead of 15.4 cm, mean unchanged (6.6 cm); with the heave observer's spectrum
-        settings that the tilt states bring (:mod:`.wave_coast`) 1, 10.7 cm, mean 6.3 cm;
-        with the spectrum smoothed (:data:`~.wave_coast.BAND_SMOOTHING`) none, worst 9.7 cm,
-        mean 6.1 cm (``make bench``, part ``dropout``, 2026-11-24). [``coast_tilt``]
+        accelerometer bias. False: a loose offset stands in for the tilt.
+        Needs ``coast="band"``, the attitude correction and a gyro. With the heave observer's
+        spectrum settings that the tilt states bring (:mod:`.wave_coast`) and the spectrum
+        smoothed (:data:`~.wave_coast.BAND_SMOOTHING`) they cut the tail of the dropout errors
+        (docs/decisions/gnss-fusion-coast.md). [``coast_tilt``]
     coast_tilt_band : bool
         With ``coast_tilt``: the tilt states are also measured, at every band step, by the
         coast attitude's own tilt about N / E, the vessel's wave roll and pitch modelled as a
         band from their spectrum (:mod:`.wave_coast`, "The wave tilt"). In a gap this is the
-        second source of the tilt besides the acceleration. False: the acceleration alone
-        (until 2026-11-24). [``coast_tilt_band``]
+        second source of the tilt besides the acceleration. False: the acceleration alone.
+        [``coast_tilt_band``]
     gyro_bias_sigma : float
         Gyro bias instability, the Gauss-Markov standard deviation of the tilt states' bias
-        error [rad/s], (0, 1] (VesselMotion's default 5e-5; 1e-4 coasted worse: 3 of 60 over
-        10 cm). [``gyro_bias_sigma``]
+        error [rad/s], (0, 1] (VesselMotion's default 5e-5; a larger value coasts worse).
+        [``gyro_bias_sigma``]
     gyro_bias_tau : float
         Its correlation time [s], 0.1 … 1e6. [``gyro_bias_tau``]
     antenna_sigma_h, antenna_sigma_v : float
         Standard deviation of one antenna position, horizontal and vertical [m], (0, 100]: the
         weight of a fix's attitude in the tilt states (:func:`~.antenna_attitude.antenna_attitude_std`; RTK 1 and
-        1.5 cm) and the fix noise of ``pos_std`` (:mod:`.fusion_error`). [``antenna_sigma_h``,
+        1.5 cm) and the fix noise of ``pos_std`` (:mod:`.error_model`). [``antenna_sigma_h``,
         ``antenna_sigma_v``]
     acc_noise : float
         Accelerometer white-noise density [m/s²/√Hz], (0, 10] (VesselMotion's default MEMS
-        7e-4): the sensor's, for ``pos_std`` only (:mod:`.fusion_error`); the filter blends
+        7e-4): the sensor's, for ``pos_std`` only (:mod:`.error_model`); the filter blends
         with ``q``. [``acc_noise``]
     gyro_noise : float
         Gyro white-noise density (angle random walk) [rad/s/√Hz], (0, 1] (VesselMotion's
         default 5e-5): the random walk of the tilt states' attitude error (``coast_tilt``,
-        :class:`~.aided_band.Tilt`; until 2026-11-24 they had the bias wander alone), and with
+        :class:`~.aided_band.Tilt`), and with
         ``gyro_bias_sigma`` and ``gyro_bias_tau`` the attitude error of ``pos_std``.
         [``gyro_noise``]
     """
@@ -315,7 +302,7 @@ class GnssAccFusionResult:
         COG position [m] and velocity [m/s], NED.
     pos_std : tuple of float
         1σ of the fused position [m]: the covariance of the error the filter makes as it runs,
-        with the sensors' noises (:mod:`.fusion_error`), or in a GNSS gap bridged by the wave
+        with the sensors' noises (:mod:`.error_model`), or in a GNSS gap bridged by the wave
         coast the coast's own and the output's spread about it (module docstring); 0 before
         initialisation.
     euler : tuple of float
@@ -371,7 +358,7 @@ def pi_pull(q: np.ndarray, bias: np.ndarray, rot_fix: np.ndarray, dt_fix: float,
         Time since the previous fix [s].
     tau : float
         Time constant [s]: k_p = 2/τ, k_i = 1/τ² (critically damped;
-        :func:`~.fusion_error.pi_gains`).
+        :func:`~.error_model.pi_gains`).
     alpha : numpy.ndarray, optional
         (3,) proportional gains per NED axis to use instead of the PI's (at most its own:
         :meth:`GnssAccFusion._correct_attitude`).
@@ -566,12 +553,12 @@ class GnssAccFusion:
         # the propagated one is off by centiradians, decimetres over the arm.
         arm = np.asarray(p.acc_lever_arm) - p.arms.mean(axis=0)
         # after a gap longer than max_coast the output has been invalid for a while and the
-        # coasted attitude and accelerometer bias are not worth keeping (on the paper-001 set-up
-        # after 5 min: 20 mrad, and the bias states 0.08 m/s² off, took more than 40 s to
-        # settle), nor the velocity of an inertial coast (an update would pull the position but
-        # keep a metres-per-second error, and gate out the next fixes). The velocity that the
-        # wave coast held (0.2 m/s off at most) is kept: a restart at rest errs 30-40 cm in the
-        # first seconds.
+        # coasted attitude and accelerometer bias are not worth keeping (after a 5-min gap
+        # centiradians and centimetres per second squared off, slow to settle), nor the velocity
+        # of an inertial coast (an update would pull the position but keep a metres-per-second
+        # error, and gate out the next fixes). The velocity that the wave coast held (decimetres
+        # per second off at most) is kept: a restart at rest errs decimetres in the first
+        # seconds (docs/decisions/gnss-fusion-filter.md).
         restart = not self.initialised or self.since_fix > p.max_coast
         rot_arm = sol.rot if p.propagation == "hold" or restart else quat_to_rot(self.q)
         z = sol.centroid + rot_arm @ arm
@@ -635,9 +622,8 @@ class GnssAccFusion:
         """A held attitude with no fix to hold and no gyro attitude to follow (no gyro, or no
         band coast to keep one; module docstring, item 2): the acceleration is then turned by
         an attitude that the vessel has left, and the output is not valid. The wave coast
-        still bounds the drift (seed 1's 30 s dropout without a gyro: 6.3 m east, against
-        186 m without the coast), but neither it nor ``pos_std`` knows the attitude's error
-        then."""
+        still bounds the drift (metres through a 30 s dropout, against hundreds of metres
+        without the coast), but neither it nor ``pos_std`` knows the attitude's error then."""
         return (self.params.propagation == "hold" and not self._coast_gyro()
                 and self.since_fix > HOLD_OVERDUE * self.fix_interval)
 
@@ -696,15 +682,12 @@ class GnssAccFusion:
         ``fix_std`` the fix attitude's standard deviations [rad, NED].
 
         Beyond a plain PI, each axis's proportional gain is at most the one-step Kalman gain of
-        the attitude error's covariance (:meth:`~.fusion_error.FusionError.attitude_gain`). At
+        the attitude error's covariance (:meth:`~.error_model.FusionError.attitude_gain`). At
         steady rate the PI's own is the smaller (1 Hz, τ 30 s: 0.067 against 0.1-0.6), so
         nothing changes there; after a gap of τ/2 or more the PI's is 1, which hands the fix's
         attitude noise (1.9 mrad about N on the paper-001 set-up, 1.9 cm at the COG over the 10 m
-        arm) to the output whole. Over the ten hardest dropouts (``docs/paper001_dropout.md``)
-        the largest east error in the 5 s after the gap fell from 1.6-7.6 cm (mean 3.9) to 1.2-6.0 cm (mean 3.2),
-        and in the 25 s after those from 2.0-3.9 (2.7) to 1.9-3.1 cm (2.3), down in the first
-        5 s from 2.6 to 2.3 cm on average; before the gaps nothing changed, and in them at most
-        0.1 cm, where a skipped epoch had doubled an interval (a scan, 2026-11-24).
+        arm) to the output whole. The cap lowers the error in the first half minute after a
+        gap and changes nothing before it (docs/decisions/gnss-fusion-filter.md).
         """
         p = self.params
         if p.propagation == "hold":
@@ -725,7 +708,7 @@ class GnssAccFusion:
         vel = x[3:6].copy()
         if w is not None and self.initialised:
             vel -= rot @ cross3(w - self.gyro_bias, p.acc_lever_arm)
-        if self.coast_var is None:     # the error as the filter runs (fusion_error)
+        if self.coast_var is None:     # the error as the filter runs (error_model)
             var = self.error.position_var(rot)
         else:   # in a gap: the coast's own, and how far the output strays from it (module docstring)
             var = self.coast_var + self.coast_track

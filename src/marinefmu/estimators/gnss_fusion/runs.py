@@ -1,4 +1,4 @@
-"""Whole-record runs of the GNSS + accelerometer fusion (:mod:`.gnss_fusion`, paper 001):
+"""Whole-record runs of the GNSS + accelerometer fusion (:mod:`.filter`, paper 001):
 :func:`fuse` over arrays, with the RTS fixed-interval smoother for post-processing
 (:func:`rts_smooth`), and :func:`fuse_receiver` for a data set with one receiver.
 
@@ -18,7 +18,7 @@ from .filter import GnssAccFusionParams, GnssAccFusion, transition
 def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyro: np.ndarray | None = None,
          params: GnssAccFusionParams | None = None, smooth: bool = False, gnss_valid: np.ndarray | None = None
          ) -> dict[str, np.ndarray]:
-    """Run :class:`GnssAccFusion` over whole records, optionally with the RTS smoother.
+    """Run :class:`~.filter.GnssAccFusion` over whole records, optionally with the RTS smoother.
 
     Parameters
     ----------
@@ -38,9 +38,8 @@ def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyr
     params : GnssAccFusionParams, optional
     smooth : bool
         Also return the RTS fixed-interval smoothed ``pos_smooth`` and ``vel_smooth``. Through
-        a GNSS gap of up to ``max_coast`` s it does better than the real-time output (30 s
-        dropouts of the paper-001 set-up: worst east 9.0 cm against 9.7 cm, and 9.4 against
-        10.4 cm later in a run; ``make bench``, part ``dropout``); over a longer
+        a GNSS gap of up to ``max_coast`` s it does better than the real-time output (``make
+        bench``, part ``dropout``); over a longer
         one, which ends in a re-initialisation that the smoother does not cross, and over a
         gap that ends the record, it is the real-time output (:func:`orphan_steps`).
 
@@ -89,7 +88,7 @@ def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarr
     For a data set with a single antenna (and a compass) instead of four: ``f_n`` is the
     specific force already rotated into NED by an external attitude (eqs. 25-26 done
     outside: f_n = R_nb f_b), ``pos`` the receiver's fixes of the accelerometer point.
-    :class:`GnssAccFusion` runs with ``attitude_correction=False`` (a_n = f_n + g_n),
+    :class:`~.filter.GnssAccFusion` runs with ``attitude_correction=False`` (a_n = f_n + g_n),
     ``propagation="hold"`` and no lever arm, and each fix is handed to it as a rigid antenna
     set at identity attitude around the fix (the antenna solution then returns exactly the
     fix), so the Kalman filter, gating, bias states, coasting and re-initialisation are the
@@ -117,7 +116,7 @@ def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarr
     """
     p = params or GnssAccFusionParams()
     # centred virtual antennas: the attitude is exact and has no share in pos_std; they carry the
-    # receiver's one error, so the centroid's noise is the receiver's (fusion_error: σ²/4)
+    # receiver's one error, so the centroid's noise is the receiver's (error_model: σ²/4)
     p = replace(p, attitude_correction=False, propagation="hold", acc_lever_arm=(0.0, 0.0, 0.0),
                 antennas=tuple(tuple(a) for a in (p.arms - p.arms.mean(axis=0)).tolist()),
                 antenna_sigma_h=2.0 * p.antenna_sigma_h, antenna_sigma_v=2.0 * p.antenna_sigma_v)
@@ -134,11 +133,10 @@ def orphan_steps(priors: list, accepted: np.ndarray) -> np.ndarray:
 
     Why: such a stretch is a GNSS gap that ended in a re-initialisation (longer than
     ``max_coast``) or ends the record, bridged by the wave coast's pseudo-fixes. There the
-    filter's bias states follow g × the drifting tilt of its gyro-propagated attitude (0.075
-    m/s² after 5 min on the paper-001 set-up), far beyond their random walk, and the smoother,
-    which takes the bias as nearly constant, spread the late value back over the whole gap and
-    before it: through the four 5-min gaps of the bench it erred 31.0 cm east at most against
-    23.5 cm real time. :func:`fuse` keeps the filtered state over these steps (``hold`` of
+    filter's bias states follow g × the drifting tilt of its gyro-propagated attitude, far
+    beyond their random walk, and the smoother, which takes the bias as nearly constant, would
+    spread the late value back over the whole gap and before it, worse than the real-time
+    output (docs/decisions/gnss-fusion-filter.md). :func:`fuse` keeps the filtered state over these steps (``hold`` of
     :func:`rts_smooth`). A step counts from the last fix before the restart on, since nothing
     after that fix reaches it.
 

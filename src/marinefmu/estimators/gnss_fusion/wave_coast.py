@@ -2,18 +2,18 @@
 
 Why: an inertial coast cannot hold centimetres for 30 s with a MEMS gyro. The gyro bias wander
 (VesselMotion's default: 5e-5 rad/s Gauss-Markov, 50 s) tilts a perfectly initialised
-attitude by ~0.5-1 mrad within 30 s, and g·ε integrated twice is metres (measured on the paper
-001 set-up: 1-6 m after 30 s, README). A floating vessel whose mean position is steady or moves
-steadily (moored, dynamically positioned, drifting) has no acceleration of its own below the
-wave band, so there the accelerometer's low-frequency content is error, not motion.
+attitude by ~0.5-1 mrad within 30 s, and g·ε integrated twice is metres (:func:`coast_floor`).
+A floating vessel whose mean position is steady or moves steadily (moored, dynamically
+positioned, drifting) has no acceleration of its own below the wave band, so there the
+accelerometer's low-frequency content is error, not motion.
 
 Method, per NED axis:
 
-1. a band observer — :class:`~.heave.OscillatorBankHeave` with ``model="band"``, the heave observer of
-   paper 003 with a :data:`SPECTRUM_WINDOW` s spectrum window, run on one axis of the
-   attitude-corrected acceleration a_n at the accelerometer, decimated to about :data:`RATE` Hz
-   by block means — measures the sea's spectrum along the axis and builds the model of its
-   wave-frequency motion (band elements and an offset);
+1. a band observer — :class:`~marinefmu.estimators.heave.bank.OscillatorBankHeave` with
+   ``model="band"``, the heave observer of paper 003 with a :data:`SPECTRUM_WINDOW` s spectrum
+   window, run on one axis of the attitude-corrected acceleration a_n at the accelerometer,
+   decimated to about :data:`RATE` Hz by block means — measures the sea's spectrum along the
+   axis and builds the model of its wave-frequency motion (band elements and an offset);
 2. :class:`~.aided_band.AidedBand` runs that model in one Kalman filter with a
    constant-velocity drift, updated by the acceleration at every band step and by every
    accepted GNSS fix z of the accelerometer point, so the fixes anchor the wave states as well
@@ -21,47 +21,42 @@ Method, per NED axis:
 3. in a gap the filter goes on with the acceleration alone: the coast position is its
    Σ elements + drift.
 
-Until 2026-11-22 step 2 was the band observer alone plus a straight line fitted to the anchors
-z − d_w of the last ``window`` s; its wave displacement d_w carried g × the antenna-attitude
-error at 0.1-0.3 rad/s (3.5 cm RMS east before the gap on the paper-001 set-up), which the
-fixes now remove (:mod:`.aided_band`, with the figures). The error left is the band
-observer's acceleration-only response through the gap, whose offset must follow g × the
-attitude error of the corrected acceleration (:mod:`.aided_band`). A vessel that manoeuvres during the gap
-breaks the drift assumption: use ``coast="inertial"`` in :class:`~.gnss_fusion.GnssAccFusionParams`
-then. :class:`~.gnss_fusion.GnssAccFusion` feeds the coast position to its Kalman filter as a
-pseudo-fix every 0.1 s while GNSS is missing.
+The fixes in step 2 remove the g × antenna-attitude error that the band observer's wave
+displacement carries at 0.1-0.3 rad/s, which a straight line fitted to the anchors cannot
+(:mod:`.aided_band`). The error left is the band observer's acceleration-only response
+through the gap, whose offset must follow g × the attitude error of the corrected
+acceleration (:mod:`.aided_band`). A vessel that manoeuvres during the gap breaks the drift
+assumption: use ``coast="inertial"`` in :class:`~.filter.GnssAccFusionParams` then.
+:class:`~.filter.GnssAccFusion` feeds the coast position to its Kalman filter as a pseudo-fix
+every 0.1 s while GNSS is missing.
 
-With tilt states (``tilt``; the default of :class:`~.gnss_fusion.GnssAccFusion` since
-2026-11-24) the north and east filters carry the tilt error of the correcting attitude
-explicitly (:class:`~.aided_band.Tilt`), measured by each fix's antenna attitude
+With tilt states (``tilt``; the default of :class:`~.filter.GnssAccFusion`) the north and
+east filters carry the tilt error of the correcting attitude explicitly
+(:class:`~.aided_band.Tilt`), measured by each fix's antenna attitude
 (:meth:`WaveCoast.attitude_fix`), and all three observers keep the heave observer's offset
 noise. Without them the horizontal observers use ``offset_noise``
 :data:`HORIZONTAL_OFFSET_NOISE`, ten times the heave default: the horizontal a_n carries g ×
 the attitude error of the antenna fixes (about 5 mm/s² RMS at 0.1-0.25 rad/s with 1 cm fixes
 on an 8 m baseline) and, in a gap, g × the gyro-propagated tilt drift, which a weaker offset
-leaves to the lowest band elements as displacement (with the aided filter, over the 30 dropouts of :mod:`.aided_band`, east over
-10 cm in 28 / 14 / 5 with 1e-4 / 3e-4 / 1e-3; 1e-3 raised to 3e-3 in gaps only: 12).
+leaves to the lowest band elements as displacement (docs/decisions/gnss-fusion-coast.md).
 
-The wave tilt (``tilt_band``, the default of :class:`~.gnss_fusion.GnssAccFusion` since
-2026-11-24, session 33). In a gap the tilt states had only the acceleration to tell the tilt
-error ε of the correcting attitude from sway, and what they missed was the whole tail of the
-30 s dropouts (told the true tilt, the five worst erred 2.3-3.8 cm instead of 10-11 cm;
-``docs/paper001_dropout.md``). The correcting attitude's own tilt about N and E
-(:func:`~marinefmu.frames.nav_tilt`) is the vessel's wave roll and pitch less ε, θ_used = θ − ε
-to second order, and a floating vessel's wave tilt has, like its sway, nothing below the
-wave band. So the north and east filters also carry a band model of the wave tilt about E / N
-and measure θ_used at every band step (:meth:`~.aided_band.AidedBand.wave_tilt`, σ
-:data:`~.aided_band.ANGLE_SIGMA`): in a gap the gyro's tilt, which turns with the bias, is
-then a second source of ε besides the acceleration. The band's spectrum comes from a fourth
-and fifth :class:`~.heave.OscillatorBankHeave` fed the tilt's second difference at the band rate (its
-spectrum S_θ̈ = ω⁴S_θ, so its "heave" band is the tilt's), with the same window and floor and
-damping :data:`ANGLE_DAMPING`; the band drops the observer's offset. A tilt whose band variance is
-under ANGLE_SIGMA² gets no band: ε is measured alone, the tilt's variance added to the noise
-(:meth:`~.aided_band.AidedBand.weak_angle`; in the paper-001 beam sea the tilt about E is
-0.03 mrad, and a band of 33 elements of noise made the fusion take 9.3 s instead of 7.3 s
-for a 390 s record, a scan). ``make bench``, part ``dropout``, 2026-11-24, session 33, max
-east error through 30 s dropouts: the 60 early ones worst 10.7 → 9.9 cm, mean 5.9 → 5.3 cm;
-the 60 later ones 9.8 → 8.2 cm, 5.8 → 5.1 cm; north and down unchanged (README).
+The wave tilt (``tilt_band``, the default of :class:`~.filter.GnssAccFusion`). In a gap the
+tilt states have only the acceleration to tell the tilt error ε of the correcting attitude
+from sway, and what they miss makes the tail of the dropout errors. The correcting attitude's
+own tilt about N and E (:func:`~marinefmu.frames.nav_tilt`) is the vessel's wave roll and pitch
+less ε, θ_used = θ − ε to second order, and a floating vessel's wave tilt has, like its sway,
+nothing below the wave band. So the north and east filters also carry a band model of the wave
+tilt about E / N and measure θ_used at every band step
+(:meth:`~.aided_band.AidedBand.wave_tilt`, σ :data:`~.aided_band.ANGLE_SIGMA`): in a gap the
+gyro's tilt, which turns with the bias, is then a second source of ε besides the acceleration.
+The band's spectrum comes from a fourth and fifth
+:class:`~marinefmu.estimators.heave.bank.OscillatorBankHeave` fed the tilt's second difference
+at the band rate (its spectrum S_θ̈ = ω⁴S_θ, so its "heave" band is the tilt's), with the same
+window and floor and damping :data:`ANGLE_DAMPING`; the band drops the observer's offset. A tilt
+whose band variance is under ANGLE_SIGMA² gets no band: ε is measured alone, the tilt's
+variance added to the noise (:meth:`~.aided_band.AidedBand.weak_angle`), as a band fitted to
+noise costs time and helps nothing (in the paper-001 beam sea the tilt about E is 0.03 mrad).
+The measurements behind the wave tilt are in docs/decisions/gnss-fusion-coast.md.
 """
 from __future__ import annotations
 
@@ -83,64 +78,38 @@ HORIZONTAL_OFFSET_NOISE = 1e-3
 #: Fewest fixes before the coast gives a position.
 MIN_FIXES = 3
 #: First spectrum window of the band observers [s] (with tilt states it then grows, below): the
-#: coast gives positions from this long into a run. Measured with the fusion's attitude, before
-#: ``coast_attitude_tau`` (max east error through a 30 s dropout at 1 Hz, paper-001 set-up,
-#: fused real time): over the 30 dropouts at 270 / 300 / 320 s of seeds 1-10, over 10 cm in 5 with the
-#: heave observer's 120 s (mean 7.9 cm, worst 15.2), 2 with 180 s (7.1 cm, worst 13.7) and
-#: 2 with 240 s (7.3 cm, worst 14.1); on 10 more (seeds 11-20 at 400 s, not used to choose)
-#: 2 over 10 cm with 120 s (mean 8.2 cm) and 3 with 180 s (7.6 cm, all three 10.2-10.5 cm).
-#: A longer window resolves the sea's spectrum, and so the band elements' weights, more finely.
+#: coast gives positions from this long into a run. A longer window resolves the sea's
+#: spectrum, and so the band elements' weights, more finely: 180 s coasted better than the
+#: heave observer's 120 s, and 240 s no better (docs/decisions/gnss-fusion-coast.md).
 SPECTRUM_WINDOW = 180.0
 #: Time between the band observers' spectrum updates [s]. The sea state changes over tens of
-#: minutes; the heave observer's 15 s (paper 003) here cost 60 % of the fusion's time (three
-#: 217-state steady-state filters rebuilt with ``dlqe``) for no better coast: the 30 s dropout
-#: of the paper-001 set-up erred at most 7.0 / 4.9 / 11.5 cm east over seeds 1-3 with 15 s,
-#: 8.4 / 3.8 / 11.2 cm with 60 s, and the fusion ran 2.3 times faster (measured with the line
-#: coast, before :mod:`.aided_band`).
+#: minutes; the heave observer's 15 s (paper 003) here costs more than half the fusion's time
+#: (three 217-state steady-state filters rebuilt with ``dlqe``) for no better coast
+#: (docs/decisions/gnss-fusion-coast.md).
 PEAK_INTERVAL = 60.0
 #: Lowest band element of the band observers [rad/s]: the heave observer's ``omega_min``, the
-#: setting all the coast's figures were measured with. The heave observer's own default
-#: (``band_min`` 0.3 since 2026-11-23, for long seas) changed nothing that counts here: over the
-#: 40 dropouts of :mod:`.aided_band` east over 10 cm in 1 (10.3 cm instead of 10.6), mean
-#: 6.8 cm as before; 5-min dropouts worst N / E / D 12.4 / 22.6 / 13.9 cm (12.7 / 22.6 / 13.3).
+#: setting the coast was tuned with; the heave observer's own default ``band_min`` (0.3, for
+#: long seas) changes nothing that counts here (docs/decisions/gnss-fusion-coast.md).
 BAND_MIN = 0.25
 #: The band observers' spectrum. With tilt states (the default) they take the heave observer's
 #: own settings: the window grows from :data:`SPECTRUM_WINDOW` with the data up to its
-#: ``window_max`` (:data:`~.heave.WINDOW_MAX`) and the element variances are integrated over
-#: their bands. With the tilt states that made the spectrum count: over the 60 dropouts of
-#: :mod:`.aided_band` east at 10 cm or more in 1 instead of 2, mean east 6.3 instead of 6.6 cm
-#: (a scan, 2026-11-24; ``make bench`` in the README). Without tilt states they keep the old
-#: settings, a fixed window (``window_max`` = window) and variances read at the element's
-#: frequency (``band_variance = "point"``): with the loose offset, integrated variances moved
-#: the 40 dropouts of 2026-11-23 by noise only (``marinefmu bench --parts dropout``: mean
-#: N / E / D 2.0 / 6.8 / 4.2 cm as before, 2 of 40 at 10 cm or more instead of 1).
+#: ``window_max`` (:data:`~marinefmu.estimators.heave.common.WINDOW_MAX`) and the element
+#: variances are integrated over their bands, which with the tilt states coasts better. Without
+#: tilt states they keep a fixed window (``window_max`` = window) and variances read at the
+#: element's frequency (``band_variance = "point"``): with the loose offset, integrated
+#: variances moved the dropout errors by noise only (docs/decisions/gnss-fusion-coast.md).
 
 #: Half-width of the smoothing of the band observers' element densities over their neighbours
-#: (with tilt states; :func:`~.band_bank.smooth_densities`; the heave observer's default is 0).
-#: The dropouts come minutes into a run, when the spectrum window holds one realisation of a few
-#: minutes, whose element weights scatter ±50 % about the sea's (with the 1 h spectrum of
-#: another seed, an oracle, the ten hardest dropouts erred 9.2 / 7.87 cm worst / mean east
-#: instead of 10.7 / 8.66 cm). Scans of 2026-11-24 (max east error through the gap, fused real
-#: time; the smoothed densities scaled to keep their sum, where the code keeps the variance):
-#: on the ten hardest, log-domain 1-2-1 9.7 / 8.11 cm, 1-2-3-2-1 10.0 / 8.05 cm; in the
-#: linear domain 1-2-1 10.2 / 8.65 cm, and a multitaper spectrum (DPSS, NW 2-6) 16.1-17.1 cm
-#: worst (its tapers spread the low-frequency tilt into the lowest elements, which the
-#: periodogram leaves below the floor). ``make bench``, part ``dropout``, 2026-11-24, max east
-#: error: over the 60 early dropouts none at 10 cm or more (worst 9.7 cm, seed 27 at 350 s;
-#: 10.7 before), mean N / E / D 2.04 / 6.06 / 2.91 cm (2.04 / 6.27 / 2.99), better on 41 and
-#: worse on 9; over the 60 later ones mean east 5.94 cm (6.02), better on 32 and worse on 12,
-#: but one at 10.4 cm (seed 2 at 1200 s; 9.7 before). On 20 fresh dropouts (seeds 41-60 at
-#: 330 s, a scan) no change: mean east 6.27 cm (6.29), worst 10.1 cm either way; at 1230 s
-#: 5.61 cm (5.70), worst 7.3 cm (7.2). A small gain
-#: on the mean, none on the tail. The heave observer keeps 0: on its 30-min checks the band
-#: model's RMS error moved by at most 0.5 % (Hs 4 / Tp 14 2.941 → 2.956 cm, Hs 4 / Tp 12
-#: 2.297 → 2.313, Hs 2.5 / Tp 9 1.033 → 1.030, Hs 1 / Tp 6 0.265 → 0.266; a scan), as its
-#: window grows to 20 minutes.
+#: (with tilt states; :func:`~marinefmu.estimators.heave.band_bank.smooth_densities`; the heave
+#: observer's default is 0). The dropouts come minutes into a run, when the spectrum window
+#: holds one realisation of a few minutes, whose element weights scatter ±50 % about the sea's;
+#: a log-domain 1-2-1 average steadies them, a small gain on the mean error and none on the
+#: tail. The heave observer keeps 0: its window grows to 20 minutes, and there smoothing moves
+#: the band model's error by under 1 % (docs/decisions/gnss-fusion-coast.md).
 BAND_SMOOTHING = 1
 #: Damping ratio of the wave-tilt band's elements (``tilt_band``): the roll is a narrow
-#: resonance. Scans on the hardest 30 s dropouts (max east error, seeds 27 / 54,
-#: 2026-11-24, :data:`~.aided_band.ANGLE_SIGMA` 1e-3): 0.1 10.1 / 10.3 cm, 0.05 9.5 / 9.2 cm,
-#: 0.03 9.5 / 7.7 cm.
+#: resonance, which narrower elements than the heave observer's 0.1 follow better
+#: (docs/decisions/gnss-fusion-coast.md).
 ANGLE_DAMPING = 0.05
 
 
@@ -196,7 +165,7 @@ class WaveCoast:
     def reset(self) -> None:
         """Forget everything (observers, block, filters)."""
         # spectrum: with tilt states the heave observer's own settings and smoothed element
-        # weights (BAND_SMOOTHING), without them its old settings
+        # weights (BAND_SMOOTHING), without them a fixed window and point variances
         spectrum = ({"band_smoothing": BAND_SMOOTHING} if self.tilt is not None
                     else {"window_max": self.spectrum_window, "band_variance": "point"})
         vertical = HeaveObserverParams(model="band", smoother_lag=0.0, peak_interval=PEAK_INTERVAL,
@@ -244,7 +213,7 @@ class WaveCoast:
         self.acc_sum[:] = 0.0
         self.step_sum[:] = 0.0
         self.in_block = 0
-        with one_blas_thread():                 # the filters' products are small (blas module)
+        with one_blas_thread():                 # the filters' products are small (numerics.one_blas_thread)
             for obs, band, a, y in zip(self.observers, self.bands, mean, step_mean):
                 observe(obs, float(a), self.block * self.dt)
                 if obs.model is not None and obs.model is not band.model:
@@ -339,9 +308,8 @@ class WaveCoast:
     def position(self) -> np.ndarray | None:
         """Coast position of the accelerometer point now [m, NED], or None before the first
         spectrum or before :data:`MIN_FIXES` fixes. However long ago the last fix was: the
-        error grows slowly (the fused output through 5-min gaps of the paper-001 set-up, seeds
-        1-4: at most 23 cm; :meth:`position_std` 18 cm at the end), where the inertial coast
-        is off by kilometres (README)."""
+        error grows slowly (decimetres after a 5-min gap on the paper-001 set-up), where an
+        inertial coast is off by kilometres."""
         if not self.ready or self.k_fix is None or min(b.fixes for b in self.bands) < MIN_FIXES:
             return None
         lead = self._lead()
@@ -349,7 +317,7 @@ class WaveCoast:
 
     def position_std(self) -> np.ndarray:
         """Standard deviation [m] of :meth:`position` per NED axis, from each axis filter's
-        covariance (it grows through a gap: 4 cm east 30 s into one, 18 cm after 5 min)."""
+        covariance (it grows through a gap)."""
         lead = self._lead()
         return np.array([b.std(lead)[0] for b in self.bands])
 

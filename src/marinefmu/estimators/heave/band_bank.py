@@ -1,4 +1,4 @@
-"""The ``model="band"`` observer of :mod:`.heave` (beyond paper 003): a comb of damped
+"""The ``model="band"`` observer of :mod:`marinefmu.estimators.heave` (beyond paper 003): a comb of damped
 band-pass resonators spanning the wave band, each weighted by the measured spectrum, so that the
 Kalman filter's model of heave has the sea's spectrum and no heave below the band.
 
@@ -6,7 +6,7 @@ Why. The paper's undamped modes at the spectral peaks model a sea as a few lines
 white acceleration noise, each mode also claims a flat heave spectrum q_j/ω_j⁴ below its
 frequency. On a broad long-period sea (Tp 9-14 s) the filter then lets accelerometer bias and
 noise below the band into heave and distorts the gain between and beside the modes
-(measured: 13 cm RMS error at Hs 4 m, Tp 14 s). The filter is only the optimal (Wiener)
+(docs/decisions/heave-models.md). The filter is only the optimal (Wiener)
 estimator when its model has the signal's spectrum.
 
 Element j at ω_j (a geometric grid of ``count`` frequencies in [ω_min, ω_max]) is ``stages``
@@ -98,14 +98,14 @@ def band_elements(spectrum: Spectrum, grid: np.ndarray, floor: float,
     Element j covers the band between the geometric midpoints of its neighbours in ``grid``
     (the end elements as far out as in). ``variance="integral"`` (default): its variance is the
     heave spectrum S_z(ω) = S_ä(ω)/ω⁴ integrated over that band, each periodogram bin spread
-    evenly over its width. ``"point"`` (the only way until 2026-11-23): S_z interpolated at ω_j
-    times the grid's spacing there, one or two bins of a periodogram whose values scatter
-    ±100 % (measured in :data:`~.heave.WINDOW_MAX`).
+    evenly over its width. ``"point"``: S_z interpolated at ω_j times the grid's spacing there,
+    one or two bins of a periodogram whose values scatter ±100 %
+    (:data:`~marinefmu.estimators.heave.common.WINDOW_MAX`, docs/decisions/heave-window.md).
 
     Parameters
     ----------
     spectrum : Spectrum
-        From :func:`~.wave_peaks.acceleration_spectrum`.
+        From :func:`~.spectrum.acceleration_spectrum`.
     grid : numpy.ndarray
         (M,) candidate frequencies [rad/s], ascending, geometric, M ≥ 2 (:func:`band_grid`).
     floor : float
@@ -143,10 +143,9 @@ def smooth_densities(density: np.ndarray, width: np.ndarray, half_width: int) ->
 
     Why. The elements' weights should be the sea's spectrum, but a few minutes of record give
     one realisation of it: a Hann periodogram's bins scatter ±100 %, and an element's band of
-    2-4 bins (7 % wide at 36 elements) still ±50 % (paper-001 set-up, east at 300 s, seed 27:
-    element variances 0.15-2.4 × those of an hour of the same sea; at 0.74 rad/s 6.6 times too
-    low). An element weighted far below its neighbours leaves the acceleration at its frequency
-    to them, whose ω² turn it into displacement 7-15 % off. The ensemble spectrum is smooth on
+    2-4 bins (7 % wide at 36 elements) still ±50 % (docs/decisions/gnss-fusion-coast.md). An
+    element weighted far below its neighbours leaves the acceleration at its frequency to them,
+    whose ω² turn it into displacement of the wrong size. The ensemble spectrum is smooth on
     that scale, so averaging neighbours trades a little resolution for a steadier weight. The
     average is of log densities (a geometric mean: a steep band edge, where the density falls
     by decades from one element to the next, does not spill into the elements beyond it, as an

@@ -37,7 +37,7 @@ class OscillatorBankHeave:
 
     Examples
     --------
-    >>> obs = HeaveObserver(HeaveObserverParams(model="band", window=60.0))
+    >>> obs = OscillatorBankHeave(HeaveObserverParams(model="band", window=60.0))
     >>> r = obs.step(-9.80665, 0.0, 0.0, 0.1)
     >>> r.valid, r.modes      # no spectrum before the first window is full
     (False, 0)

@@ -10,11 +10,9 @@ z = |b|·A / (√2·σ_v) ≥ :data:`MIN_Z`, with A the step's age and σ_v the 
 about its :data:`SMOOTH` s moving average (the sea's velocity; the noise of b·A, a difference of
 two values of V), and when |b| ≥ :data:`MIN_STEP`.
 
-Measured (a scan, 2026-11-23, seed 3, the heave checks' records, a 1200 s window every 15 s):
-without a step the largest z over 30 minutes is 0.6-1.9 on Hs 1-4 m / Tp 9-14 s and 4.6 on
-Hs 1 / Tp 6 s (a 0.0006 m/s² change of the simulated bias); a step of 0.05 m/s² reaches z 8 in
-75 s (Hs 2.5 / Tp 9 s) to 100 s (Hs 4 / Tp 14 s), 0.5 m/s² within 15 s, 0.02 m/s² on Hs 1 / Tp 6 s
-in 30 s. Candidates are at least :data:`MIN_AGE` s old (a younger kink is not yet told from a
+:data:`MIN_Z` sits well above the largest z that the heave checks' records reach without a
+step, while a step of a few cm/s² still reaches it within a minute or two
+(docs/decisions/heave-wiener.md). Candidates are at least :data:`MIN_AGE` s old (a younger kink is not yet told from a
 wave) and :data:`EDGE` s inside the window's old end (a hinge there is nearly the line, and its
 b is noise).
 

@@ -4,24 +4,24 @@ Fossen, "Heave motion estimation on a craft using a strapdown inertial measureme
 Heave (positive down, NED, relative to the mean position) is estimated from the vertical
 acceleration with no model of the craft, in the paper's four steps (the default estimator,
 ``model="wiener"``, shares steps 1 and 4 and replaces 2-3 by a causal Wiener filter designed
-from the spectrum: :mod:`.wiener_heave`; :func:`~.highpass_heave.heave_estimator` builds
-whichever ``model`` names):
+from the spectrum: :mod:`~marinefmu.estimators.heave.wiener`;
+:class:`~marinefmu.estimators.heave.observer.HeaveObserver` runs whichever ``model`` names):
 
 1. **Spectrum** of the vertical acceleration over the last ``window`` seconds and the position
-   spectrum A(ω) = Ä(ω)/ω² (eq. 2), :func:`~.wave_peaks.acceleration_spectrum`. Beyond the
+   spectrum A(ω) = Ä(ω)/ω² (eq. 2), :func:`~.spectrum.acceleration_spectrum`. Beyond the
    paper, the window then grows with the data up to ``window_max`` seconds (``window_max =
    window`` is the paper's fixed window): a longer record gives the band model a finer and
-   steadier spectrum (measured in :data:`WINDOW_MAX`).
+   steadier spectrum (:data:`WINDOW_MAX`).
 2. **Peaks** of A(ω) every ``peak_interval`` seconds (paper: T = 15 s) inside
-   [``omega_min``, ``omega_max``], at most ``max_modes``, :func:`~.wave_peaks.find_modes`.
+   [``omega_min``, ``omega_max``], at most ``max_modes``, :func:`~.spectrum.find_modes`.
 3. **Observer**: ``model="peaks"`` is the paper's, a Kalman filter over undamped oscillator
    modes at the peak frequencies plus a random-walk offset (eqs. 3-9), :mod:`.oscillator_bank`;
    exact (rotation) discretisation by default, the Euler form of eq. 9 selectable.
    ``model="band"`` (beyond the paper) replaces the modes by a comb of damped band-pass
    elements spanning [``band_min``, ``omega_max``], weighted by the measured spectrum
    (:mod:`.band_bank`): the filter's model then has the sea's spectrum and no heave below the
-   band, which the paper's modes lack (measured on VesselMotion, real-time RMS error at
-   Hs 4 m / Tp 14 s: 13 cm with the modes, ~3 cm with the band; README). Either way the gain is
+   band, which the paper's modes lack, so on a broad long-period sea it errs several times
+   less (docs/decisions/heave-models.md). Either way the gain is
    the steady-state gain of the model (``dlqe``), recomputed at each spectrum.
    When the mode set changes, the state is carried over (:func:`~.oscillator_bank.carry_map`)
    so heave has no transient. The first time modes are found, the filter is run over the
@@ -35,8 +35,8 @@ whichever ``model`` names):
 **Vertical acceleration** (the measurement, eq. 6). ``vertical="ned"`` (default) uses the whole
 specific force, a_d = [R_nb f_b]_d + g (exact; needs acc.x, acc.y); ``vertical="tilt"`` (needs
 only acc.z): a_d = f_z / (cosθ cosφ) + g, which removes gravity exactly but takes the horizontal
-accelerations times the tilt for heave (measured: 34 cm instead of 3.6 cm RMS error at Hs 4 m,
-Tp 14 s, where that product has energy below the band); ``vertical="paper"`` is eq. 6 as printed:
+accelerations times the tilt for heave, a product with energy below the wave band that the
+observer turns into heave error (docs/decisions/heave-models.md); ``vertical="paper"`` is eq. 6 as printed:
 the body-axis f_z itself, whose gravity part −g cosθ cosφ the offset state absorbs
 (x_off(0) = −g cosθ cosφ, eq. 7) and whose output is heave along the body z axis.
 
@@ -74,54 +74,25 @@ class SilentLog:
 VERTICAL_CHOICES = ("ned", "tilt", "paper")
 MODEL_CHOICES = ("band", "peaks", "highpass", "wiener")
 TRANSFER_CHOICES = ("exact", "paper")
-#: Default lowest band element ``band_min`` [rad/s] (:class:`HeaveObserverParams`). Measured
-#: 2026-11-23, real-time heave RMS error at the IMU [cm], default MEMS noise, truth angles;
-#: band_min 0.25 (the earlier default, = omega_min) → 0.30 → 0.35 → 0.40:
-#:
-#: * VesselMotion JONSWAP seas of the accuracy tests (30 min after 2 min, seed 3):
-#:   Hs 4 / Tp 14 3.64 → 3.26 → 3.02 → 3.81; Hs 1 / Tp 14 1.98 → 1.76 → 1.62;
-#:   Hs 4 / Tp 12 (no test's sea) 2.83 → – → 2.43; Hs 2.5 / Tp 9 and the Tp 6 seas unchanged;
-#: * smsfusion's OrcaFlex record (Tp about 14 s, but 14 % of its heave variance below
-#:   0.35 rad/s): 3.29 → 3.29 → 6.32 (true angles, :mod:`~marinefmu.bench.peer_orcaflex`).
-#:
-#: All but the Hs 4 / Tp 12 and 0.40 figures (a scan) are re-measured by ``marinefmu bench
-#: --parts heave`` (:func:`~marinefmu.papers.paper003.band_min_study`). 0.35 is best on the JONSWAP seas,
-#: whose spectrum has almost nothing below 0.75 ω_peak, and doubles the error on the broader
-#: OrcaFlex sea; 0.30 is better than 0.25 on the JONSWAP seas and equal on OrcaFlex.
-#: Not taken: dropping the lowest elements by their share of the band's variance (1-10 %:
-#: Hs 4 / Tp 14 3.34-3.44 with band_min 0.25), four stages per element (3.80), offset noise
-#: 3e-5 / 5e-5 (4.57 / 4.02).
+#: Default lowest band element ``band_min`` [rad/s] (:class:`HeaveObserverParams`). It trades
+#: narrow JONSWAP seas, whose spectrum has almost nothing below 0.75 ω_peak and which gain from
+#: a higher edge (less accelerometer noise passed as heave), against broader long-period seas,
+#: which lose the heave below it (docs/decisions/heave-band-min.md; ``marinefmu bench --parts
+#: heave`` measures it, :func:`~marinefmu.papers.paper003.band_min_study`).
 BAND_MIN = 0.3
-#: Default longest spectrum window ``window_max`` [s] (:class:`HeaveObserverParams`). Measured
-#: 2026-11-23 (a scan; ``marinefmu bench --parts heave`` re-measures the Hs 4 seas and the
-#: OrcaFlex record, :func:`~marinefmu.papers.paper003.window_max_study`), real-time heave RMS
-#: error at the IMU [cm], the checks' seas (30 min after 2 min, seed 3), before → growing
-#: window and band variances integrated (:func:`~.band_bank.band_elements`):
-#: Hs 1 / Tp 6 0.29 → 0.27; Hs 4 / Tp 6 0.52 → 0.49; Hs 2.5 / Tp 9 1.19 → 1.03;
-#: Hs 4 / Tp 12 2.63 → 2.31; Hs 1 / Tp 14 1.76 → 1.59; Hs 2.5 / Tp 14 2.65 → 2.40;
-#: Hs 4 / Tp 14 3.26 → 2.96 (the growing window alone 3.06, the integral alone 3.24); the OrcaFlex
-#: record 3.28 → 3.32. Why 1200 s (600 s until 2026-11-23): 20 minutes is the usual length of
-#: a sea-state record (a sea stays stationary for 20-30 minutes), and the Wiener filter
-#: (``model="wiener"``), whose design reads the spectrum bin by bin, gains from it on the long
-#: seas. Measured 2026-11-23 (a scan, 30 min after 2 min), ``window_max`` 600 / 1200 / 1800 s,
-#: seed 3: Hs 4 / Tp 12 2.107 / 2.076 / 2.074; Hs 2.5 / Tp 14 2.287 / 2.215 / 2.212; Hs 4 /
-#: Tp 14 2.772 / 2.693 / 2.687; Hs 2.5 / Tp 9 0.874 / 0.876 / 0.870; Hs 1 / Tp 6 0.223 / 0.220 /
-#: 0.219; seed 1, the same seas: 2.145 / 2.116 / 2.116; 2.237 / 2.188 / 2.185; 2.706 / 2.651 /
-#: 2.645; 0.895 / 0.891 / 0.887; 0.224 / 0.222 / 0.221. The band observer (seed 3, 600 / 1200 s):
-#: Hs 4 / Tp 12 2.307 / 2.297, Hs 4 / Tp 14 2.957 / 2.941, Hs 2.5 / Tp 9 1.033 / 1.033; with an
-#: oracle spectrum (the truth's acceleration over the whole 32 min run) it does no better
-#: (2.95 cm on Hs 4 / Tp 14). The price: the buffer (at 100 Hz 1 MB for the Wiener filter,
-#: 3.8 MB for the band observer) and the band observer's larger spectra (115 → 130 µs a step at
-#: 100 Hz, a scan; the Wiener filter's ~80 µs unchanged). Runs shorter than 10 minutes reach
-#: neither length. Not taken: narrower band elements (``elements`` 60, ``damping`` 0.07:
-#: 2.76 cm on Hs 4 / Tp 14, 2.10 on Hs 4 / Tp 12, but the OrcaFlex record's 120-360 s of
-#: spectrum make them 4.09 cm; ``elements`` 60 alone 2.94 cm).
+#: Default longest spectrum window ``window_max`` [s] (:class:`HeaveObserverParams`): 20 minutes,
+#: the usual length of a sea-state record (a sea stays stationary for 20-30 minutes). A longer
+#: window gives the band model and the Wiener filter, whose design reads the spectrum bin by
+#: bin, a finer and steadier spectrum; the price is the buffer (at 100 Hz about 1 MB for the
+#: Wiener filter, 3.8 MB for the band observer) (docs/decisions/heave-window.md; ``marinefmu
+#: bench --parts heave`` measures it, :func:`~marinefmu.papers.paper003.window_max_study`).
 WINDOW_MAX = 1200.0
 
 
 @dataclass(frozen=True)
 class HeaveObserverParams:
-    """Parameters of :class:`HeaveObserver` (FMU names in brackets).
+    """Parameters of :class:`~marinefmu.estimators.heave.observer.HeaveObserver` (FMU names in
+    brackets).
 
     Parameters
     ----------
@@ -136,11 +107,11 @@ class HeaveObserverParams:
         Time between peak detections [s], (0, 3600] (paper: T = 15 s). [``peak_interval``]
     model : str
         ``"wiener"`` (default), the causal Wiener filter designed from the spectrum
-        (:class:`~.wiener_heave.WienerHeave`, not this class: the most accurate, README);
-        ``"band"`` or ``"peaks"`` (the paper's modes), the observers of this module
-        (module docstring); or ``"highpass"``, the classical high-pass double integration
-        (:class:`~.highpass_heave.HighpassHeave`, a baseline, not this class). Build any of
-        them with :func:`~.highpass_heave.heave_estimator`. [``model``]
+        (:class:`~.wiener.WienerHeave`, the most accurate of the four);
+        ``"band"`` or ``"peaks"`` (the paper's modes), the observers of the module docstring
+        (:class:`~.bank.OscillatorBankHeave`); or ``"highpass"``, the classical high-pass
+        double integration (:class:`~.highpass.HighpassHeave`, a baseline). Build any of
+        them with :class:`~marinefmu.estimators.heave.observer.HeaveObserver`. [``model``]
     max_modes : int
         Most oscillator modes, 1..20 (``model="peaks"``). [``max_modes``]
     omega_min, omega_max : float
@@ -156,9 +127,8 @@ class HeaveObserverParams:
         Lowest band element [rad/s], (0, omega_max) (``model="band"``; the peak search keeps
         ``omega_min``). Why not lower: the observer overshoots just below its lowest element
         (|H| ≈ 3-4 at 0.15-0.2 rad/s with elements from 0.25 rad/s), where the accelerometer's
-        noise and bias, as heave, grow as 1/ω⁴ (on Hs 4 m / Tp 14 s they put 2.7 cm of heave
-        error below 0.2 rad/s, 0.6 cm without them). Why not higher: the sea below it is left
-        out. For swell longer than about 16 s lower it (0.25 serves Tp ≤ 20 s). Measured in
+        noise and bias, as heave, grow as 1/ω⁴. Why not higher: the sea below it is left
+        out. For swell longer than about 16 s lower it (0.25 serves Tp ≤ 20 s).
         :data:`BAND_MIN`. [``band_min``]
     damping : float
         Damping ratio of each band element's stages, (0, 1]. [``damping``]
@@ -167,7 +137,7 @@ class HeaveObserverParams:
         an element). [``stages``]
     band_variance : str
         ``"integral"`` (default: the heave spectrum integrated over each element's band) or
-        ``"point"`` (read at the element's frequency, as until 2026-11-23),
+        ``"point"`` (read at the element's frequency),
         :func:`~.band_bank.band_elements`. [``band_variance``]
     band_smoothing : int
         Half-width of the smoothing of the band elements' heave densities over their
@@ -358,8 +328,8 @@ def read_sample(acc: Any, roll: float, pitch: float) -> tuple[np.ndarray, float,
 def read_and_start(estimator: Any, acc: Any, roll: float, pitch: float,
                    dt: float) -> tuple[np.ndarray, float, float, str | None]:
     """:func:`read_sample`, and the start of a sample-by-sample heave filter (its ``dt``,
-    ``reset()`` and ``start(dt)``, as :class:`~.highpass_heave.HighpassHeave` and
-    :class:`~.wiener_heave.WienerHeave` have them): at the first step, or afresh when the step
+    ``reset()`` and ``start(dt)``, as :class:`~.highpass.HighpassHeave` and
+    :class:`~.wiener.WienerHeave` have them): at the first step, or afresh when the step
     size changes (that reason then replaces the sample's)."""
     f, roll, pitch, warning = read_sample(acc, roll, pitch)
     if estimator.dt is not None and abs(dt - estimator.dt) > 1e-9 * estimator.dt:
@@ -379,7 +349,7 @@ def _bad_sample(acc: np.ndarray, roll: float, pitch: float) -> str | None:
 # ---- stateful observer ----------------------------------------------------------------------
 @dataclass(frozen=True)
 class HeaveResult:
-    """Output of one :meth:`HeaveObserver.step`.
+    """Output of one :meth:`~marinefmu.estimators.heave.observer.HeaveObserver.step`.
 
     Attributes
     ----------

@@ -12,10 +12,10 @@ For the filter's prior error e⁻_k = x_k − x̂_{k|k−1} and innovation ε_k 
 output rows c_s are needed (heave, heave rate), so each pending time s carries the row block
 W = c_s Cov(e⁻_s, e⁻_k) instead of a full covariance: O(lag·n²) per step, constant memory.
 A coasted step (no measurement) has K = 0. When the model changes (the observer's mode set),
-the pending times are frozen at their estimates so far (:meth:`FixedLagOutputs.freeze`): the
+the pending times are frozen at their estimates so far (:meth:`FixedLagOutputs.set_model`): the
 first innovations of a new model are not consistent with the old one's covariances, and
-propagating them through the change (exact only for a consistent model) corrupted the delayed
-heave by decimetres in tests with the paper's measurement model.
+propagating them through the change (exact only for a consistent model) corrupts the delayed
+heave by decimetres (seen in tests with the paper's measurement model).
 
 Why not filterpy: ``filterpy.kalman.FixedLagSmoother`` keeps every smoothed state ever computed
 (memory grows without bound, filterpy issue #274), costs O(lag·n³) per step, and assumes a
@@ -26,8 +26,8 @@ filterpy RTS smoother run on the data up to k, at s = k − lag.
 measured one, Φ_i is the same closed-loop matrix F = A(I − KC) and every row block starts as
 W₀ = c P⁻, so a time pushed j steps ago has W = W₀ (Fᵀ)^j. :meth:`FixedLagOutputs.set_model`
 tabulates W₀ (Fᵀ)^j and its correction gains W C ᵀ for j = 0 … lag once per model, and each
-step then costs O(lag·n_out) instead of O(lag·n_out·n²) (465 µs → a few µs per step for the
-default 5 s lag at 100 Hz and 72 states). A coasted step (Φ = A) turns the pending rows
+step then costs O(lag·n_out) instead of O(lag·n_out·n²) (for the default 5 s lag at 100 Hz
+and 72 states, a few µs per step instead of hundreds). A coasted step (Φ = A) turns the pending rows
 explicit (from the table) and propagates them exactly; lag + 1 measured steps later every
 pending time is again of the tabulated form and the rows return to the table.
 """

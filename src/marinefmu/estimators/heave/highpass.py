@@ -1,12 +1,13 @@
 """The classical heave estimator, sample by sample: high-pass filtered double integration of
-the vertical acceleration, transferred to a remote point (the baseline of issue 9's comparison).
+the vertical acceleration, transferred to a remote point (the baseline the observer models are
+compared with).
 
 Motion reference units long estimated heave this way: the vertical acceleration (gravity
-removed, :func:`~.heave.vertical_acceleration`) through 1/s² times an ``order``-th order
+removed, :func:`~.common.vertical_acceleration`) through 1/s² times an ``order``-th order
 Butterworth high pass at ω_c, H(s) = s^{order−2}/B(s), and the heave rate through
 s^{order−1}/B(s); both discrete by the bilinear transform in second-order sections
-(:func:`~.integration.highpass_sections`; the same filter as the offline
-:func:`~.integration.highpass_double_integration`). It needs no spectrum and starts at once,
+(:func:`~marinefmu.estimators.numerics.highpass_sections`; the same filter as the offline
+:func:`~marinefmu.estimators.numerics.highpass_double_integration`). It needs no spectrum and starts at once,
 but it leads and loses gain on long waves (phase lead ≈ a₁ω_c/ω rad above the corner, a₁ = 2.61
 for order 4) and amplifies low-frequency noise by 1/ω_c²: the cutoff trades the two.
 
@@ -14,10 +15,10 @@ Each section runs in transposed direct form II (the ``scipy.signal.sosfilt`` rec
 hand-written for one sample: a call to sosfilt per sample costs ten times more).
 
 The transfer to the point and the bad-sample handling are the observer's
-(:func:`~.heave.point_heave`, the last good sample held: the filter coasts on it, ``valid``
+(:func:`~.common.point_heave`, the last good sample held: the filter coasts on it, ``valid``
 false). ``valid`` also stays false for 4 time constants of the slowest pole, 4/(ζ_min ω_c),
 while the start from rest decays. The outputs have the observer's shape
-(:class:`~.heave.HeaveResult`; no delayed outputs, no modes).
+(:class:`~.common.HeaveResult`; no delayed outputs, no modes).
 """
 from __future__ import annotations
 
@@ -90,7 +91,7 @@ class HighpassHeave:
         return (-(w ** 2) * h.reshape(w.shape))
 
     def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
-        """Process one sample (arguments as :meth:`.HeaveObserver.step`)."""
+        """Process one sample (arguments as :meth:`.OscillatorBankHeave.step`)."""
         p = self.params
         f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
         if warning is None:

@@ -1,5 +1,5 @@
 """The HeaveObserver: heave at the IMU and at a remote point by whichever of the four observer
-models :attr:`HeaveObserverParams.model` names. This is the in-process model of the
+models :attr:`~.common.HeaveObserverParams.model` names. This is the in-process model of the
 HeaveObserver FMU.
 
 ========== ================================================ ==========================

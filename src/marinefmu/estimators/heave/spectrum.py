@@ -1,6 +1,6 @@
 """Steps 1-2 of paper 003 (Auestad, Gravdahl & Fossen): the spectrum of the vertical
 acceleration over a window and the peaks of the position spectrum, which become the modes of
-the heave observer (:mod:`.heave`).
+the heave observer (:mod:`.bank`).
 
 **Step 1** (section 2.1): the one-sided amplitude spectrum Ä(ω) of the acceleration over the
 window (mean removed, Hann taper, ``numpy.fft.rfft``) and the position spectrum

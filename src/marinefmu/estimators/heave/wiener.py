@@ -4,14 +4,15 @@ from vertical acceleration to heave, designed from the measured spectrum.
 Why. The band observer (:mod:`.band_bank`) is the Wiener filter of its *model*; its
 resonators spread each element's variance over a skirt, most harmfully below the sea's low
 edge, where the model then claims heave that is not there and the filter lets accelerometer
-noise through (Hs 4 m / Tp 12 s: 1.9 cm of its 2.3 cm error below 0.2 rad/s, against 1.3 cm
-for the best causal filter, :func:`~marinefmu.papers.paper003.causal_bound`). Here the
-filter is designed from the spectrum itself, with no model shape in between.
+noise through: on a long-period sea most of its error lies there, and the best causal filter
+(:func:`~marinefmu.papers.paper003.causal_bound`) errs markedly less
+(docs/decisions/heave-wiener.md). Here the filter is designed from the spectrum itself, with
+no model shape in between.
 
 Design, at every ``peak_interval`` after the first ``window`` (the window grows to
-``window_max`` as in :class:`.heave.HeaveObserver`):
+``window_max`` as in :class:`~.bank.OscillatorBankHeave`):
 
-1. The acceleration spectrum S_ä of the window (:func:`~.wave_peaks.acceleration_spectrum`)
+1. The acceleration spectrum S_ä of the window (:func:`~.spectrum.acceleration_spectrum`)
    less the sensor's noise S_n(ω) = N²/π + q²/(πω²) (``acc_noise`` N, white; ``offset_noise``
    q, the bias as a random walk; one-sided densities per rad/s), averaged over
    ±:data:`SMOOTHING`/2 of the frequency (⟨·⟩), gives the sea's heave spectrum
@@ -35,20 +36,16 @@ Design, at every ``peak_interval`` after the first ``window`` (the window grows 
 
 Bias steps. The output has no gain at zero frequency, so a constant bias never reaches it, but a
 bias *step* in mid-run would stay in the spectrum window as a 1/ω² density, taken for sea at low
-frequency until it left the window 20 minutes later (on Hs 2.5 / Tp 9 after 0.5 m/s²: 59 cm RMS in
-the second minute, 2.8 cm at 5-10 minutes; README). So every :data:`STEP_CHECK` s the window is
+frequency for as long as the window holds it (``window_max``, 20 minutes by default), and the
+heave would be decimetres wrong meanwhile (docs/decisions/heave-wiener.md). So every
+:data:`STEP_CHECK` s the window is
 searched for a step (:func:`~.bias_step.find_bias_step`: the kink it puts into the integrated
 acceleration); one found is taken out of the window and of the filter's input from its first
 sample on, and of every sample to come (the ``offset`` output includes it), and its size is
 estimated again at every check for :data:`STEP_REFINE_AGE` s as the record after it grows. The
 heave is then the heave of the run without the step (test). A warning is logged for each step.
 
-Measured (a scan, 2026-11-23, seed 3, 30 min after 2 min, real-time heave RMS error at the IMU
-[cm]; band observer → this, causal bound): Hs 4 / Tp 6 0.49 → 0.36 (0.35); Hs 2.5 / Tp 9
-1.03 → 0.87 (0.80); Hs 4 / Tp 12 2.31 → 2.00 (1.87); Hs 4 / Tp 14 2.96 → 2.64 (2.42), figures
-of the offline design from one 600 s spectrum; the estimator's own figures are in the README.
-
-Bad samples (NaN, Inf, absurd values, :func:`~.heave.read_sample`) enter the filter as the
+Bad samples (NaN, Inf, absurd values, :func:`~.common.read_sample`) enter the filter as the
 window's mean (zero acceleration: the estimate decays to zero over the memory rather than
 drifting), ``valid`` is false and a warning is logged. A change of step size restarts.
 Not a library filter: scipy designs FIR filters from magnitude specifications
@@ -78,10 +75,9 @@ BLOCK = 0.4
 #: 240 s, :func:`~marinefmu.papers.paper003.causal_bound`).
 MEMORY = 180.0
 #: Width of the moving average over the acceleration spectrum, relative to the frequency
-#: (at least one bin). Measured (a scan, 2026-11-23, seed 3, real-time heave RMS error at the
-#: IMU [cm]), Hs 4 / Tp 12 and Hs 4 / Tp 14: relative 0.05 / 0.1 / 0.2: 2.16 / 2.11 / 2.15 and
-#: 2.86 / 2.77 / 2.74; a fixed 0.025 / 0.05 / 0.1 / 0.2 rad/s: 2.24 / 2.15 / 2.23 / 2.70 and
-#: 2.97 / 2.80 / 2.82 / 3.24. Relative 0.1 is also no worse on the other seas of the checks.
+#: (at least one bin): it steadies the periodogram's scatter without blurring the sea's
+#: spectrum, and a width relative to the frequency did better than a fixed one on the
+#: long-period seas (docs/decisions/heave-wiener.md).
 SMOOTHING = 0.1
 #: Interval of the search for a bias step in the buffered window (:mod:`.bias_step`) [s].
 STEP_CHECK = 1.0
@@ -109,7 +105,7 @@ def sea_heave_density(spectrum: Spectrum, acc_noise: float, offset_noise: float,
     Parameters
     ----------
     spectrum : Spectrum
-        From :func:`~.wave_peaks.acceleration_spectrum` (one-sided density per rad/s).
+        From :func:`~.spectrum.acceleration_spectrum` (one-sided density per rad/s).
     acc_noise : float
         Accelerometer white-noise density N [m/s²/√Hz].
     offset_noise : float
@@ -152,8 +148,9 @@ def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: 
         the measured excess above ``omega_max`` (short waves a buoy follows, vibration). It
         enters the autocorrelation only, up to 2π/(M·Δt), the block mean's first null (beyond
         it the block mean passes ≤ 5 % of the power), so the filter does not amplify it:
-        without it, a wind sea reaching 6.3 rad/s with ``omega_max`` 6 met a gain of 165 at
-        6.5 rad/s and its heave was 0.9 m wrong on a 0.45 m std (test).
+        without it, a wind sea reaching just above ``omega_max`` meets a gain of two orders of
+        magnitude there and its heave is wrong by twice its standard deviation (a test covers
+        this case).
 
     Returns
     -------
@@ -198,7 +195,7 @@ class WienerHeave:
         ``acc_noise``, ``offset_noise``, ``smoother_lag``, ``vertical``, ``transfer`` and
         ``point``; ``max_modes``, ``min_separation`` and ``min_relative`` for the peaks of the
         sea's heave spectrum reported as ``modes`` and ``omega`` (the filter has no modes;
-        :func:`~.wave_peaks.find_modes` on √S_z: swell and wind sea). ``model`` is ignored.
+        :func:`~.spectrum.find_modes` on √S_z: swell and wind sea). ``model`` is ignored.
     quiet : bool
         Log nothing.
 
@@ -334,7 +331,7 @@ class WienerHeave:
         return (-(w**2) * (blocks * within).reshape(w.shape))
 
     def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
-        """Process one sample (arguments as :meth:`.HeaveObserver.step`)."""
+        """Process one sample (arguments as :meth:`.OscillatorBankHeave.step`)."""
         p = self.params
         f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
         if warning is None:

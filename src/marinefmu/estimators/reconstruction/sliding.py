@@ -1,7 +1,7 @@
 """Paper 000's reconstruction run online on a sliding window (the DisplacementReconstructor).
 
 Every ``hop`` seconds, once ``window`` seconds of samples are in, the tilt-corrected
-acceleration of the last window is decomposed (:func:`~.reconstruction.decompose`, one call per
+acceleration of the last window is decomposed (:func:`~.decomposition.decompose`, one call per
 axis), screened, and kept as a continuous-time model. Between refits each step evaluates that
 model:
 
@@ -11,7 +11,7 @@ model:
   that fixed ``delay``.
 
 The COG transfer (eq. 32) subtracts R_nb(t) l minus its straight-line trend over the window,
-the online counterpart of :func:`~.reconstruction.lever_arm_offset`'s high-pass.
+the online counterpart of :func:`~.decomposition.lever_arm_offset`'s high-pass.
 
 Bad samples (NaN, Inf, |f| > 200 m/s², |roll| or |pitch| > 80°) are replaced in the window by
 the last good sample; ``valid`` is False while more than ``max_bad_fraction`` of the fitted
