@@ -1,5 +1,5 @@
 """The HeaveObserver: heave at the IMU and at a remote point by whichever of the four observer
-models :attr:`~.common.HeaveObserverParams.model` names. This is the in-process model of the
+models ``model`` of :class:`~.common.HeaveObserverParams` names. This is the in-process model of the
 HeaveObserver FMU.
 
 ========== ================================================ ==========================
