@@ -45,10 +45,10 @@ class LibcosimBeside:
         import sys
 
         self.out = Path(work) / "libcosim.npy"
-        code = ("import os, numpy as np\nfrom marinefmu.cosim.scenarios import load_scenario\n"
+        code = ("import numpy as np\nfrom marinefmu.cosim.scenarios import load_scenario\n"
                 "from marinefmu.cosim.libcosim import run_libcosim\n"
                 f"out = run_libcosim(load_scenario({scenario!r}).system, {str(fmu_dir)!r}, {str(work)!r}, {duration}, "
-                f"{list(record)!r}, {sample})\nnp.save({str(self.out)!r}, out)\nos._exit(0)\n")
+                f"{list(record)!r}, {sample})\nnp.save({str(self.out)!r}, out)\n")
         self.proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                      text=True)
 
@@ -101,27 +101,6 @@ class Driver:
 # child process a crash or a hang is one failed test with its output attached.
 _CHILD_FLAG = "MARINEFMU_ISOLATED_CHILD"
 ISOLATED_TIMEOUT = 300.0  # s; the slowest isolated test takes ~20 s on the 2-core CI machine
-
-
-_child_status = 0
-
-
-def pytest_sessionfinish(session, exitstatus):
-    global _child_status
-    _child_status = int(exitstatus)
-
-
-def pytest_unconfigure(config):
-    """In an isolated child, leave without interpreter finalisation: a process that has run
-    several pythonfmu FMUs can abort there after its work is done (README, known issues), which
-    would turn a passed test into a failed one."""
-    import os
-    import sys
-
-    if os.environ.get(_CHILD_FLAG):
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(_child_status)
 
 
 def pytest_pyfunc_call(pyfuncitem):

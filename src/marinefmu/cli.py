@@ -331,17 +331,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def console() -> None:
-    """The ``marinefmu`` console script: :func:`main`, then leave without interpreter
-    finalisation, where pythonfmu 0.7.0 can abort a process that has run several FMU
-    instances (``corrupted double-linked list``, README "Known issues") after the work is done;
-    the output is flushed first and the exit code kept."""
-    import os
-
-    code = main()
-    sys.stdout.flush()
-    sys.stderr.flush()
-    logging.shutdown()
-    os._exit(code)
+    """The ``marinefmu`` console script: :func:`main`, whose return value is the exit code."""
+    sys.exit(main())
 
 
 if __name__ == "__main__":

@@ -4,6 +4,8 @@ Usage::
 
     python fmu_worker.py CASE FMU_NAME FMU_DIR WORK_DIR
 
+(the ``exit_*`` cases take several names, comma-separated, as FMU_NAME)
+
 prints one JSON object (the case's measurements) as the last line of stdout. The module needs
 only FMPy, numpy and (for the libcosim cases) libcosimpy: it never imports ``marinefmu``, so the
 same cases run from a virtual environment in which the source tree is not importable. Inputs
@@ -17,7 +19,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import re
 import sys
 import tempfile
@@ -490,6 +491,64 @@ def case_logging_off(name: str, fmu_dir: Path, work: Path) -> dict:
     return {"refused_parameter_status": refused_status, "zero_step_status": zero_status}
 
 
+EXIT_STEPS = 100   # steps of each instance in the exit cases, outputs read after each
+
+
+def _exit_run(names: list[str], fmu_dir: Path, work: Path, instance: str) -> tuple[list[Instance], list[int]]:
+    """One instance of each FMU in ``names``, inputs at their start values, EXIT_STEPS steps with
+    every output read after each; the instances and the statuses seen."""
+    insts = []
+    for n in names:
+        inst = Instance(fmu_dir, n, work, instance)
+        inst.init(PARAMS[n])
+        insts.append(inst)
+    statuses = set()
+    for k in range(EXIT_STEPS):
+        for inst in insts:
+            statuses.add(inst.step(k * DT, DT))
+            inst.outputs()
+    return insts, sorted(statuses)
+
+
+def _exit_state() -> dict:
+    """FMU library copies mapped in this process and those whose exit guard is armed
+    (``marinefmu.fmu.host_exit`` as bundled in the FMUs; None if no FMU has loaded it)."""
+    with open("/proc/self/maps") as maps:
+        mapped = {line.split()[-1] for line in maps if "/binaries/linux64/" in line}
+    guard = sys.modules.get("marinefmu.fmu.host_exit")
+    return {"libraries": len(mapped), "guarded": guard.guarded() if guard is not None else None}
+
+
+def case_exit_mixed(name: str, fmu_dir: Path, work: Path) -> dict:
+    """The FMUs named (comma-separated) each with one instance freed and one left alive, then a
+    normal exit: the test asserts exit code 0 (the exit-time clean-up is the case)."""
+    names = name.split(",")
+    freed, statuses = _exit_run(names, fmu_dir, work, "freed")
+    alive, more = _exit_run(names, fmu_dir, work, "alive")
+    for inst in freed:
+        inst.close()
+    return {"statuses": sorted({*statuses, *more}), **_exit_state()}
+
+
+def case_exit_kept(name: str, fmu_dir: Path, work: Path) -> dict:
+    """The FMUs named, none freed, then a normal exit."""
+    _, statuses = _exit_run(name.split(","), fmu_dir, work, "kept")
+    return {"statuses": statuses, **_exit_state()}
+
+
+def case_exit_reloaded(name: str, fmu_dir: Path, work: Path) -> dict:
+    """The FMUs named, all freed (FMPy unloads every library copy it can), then all instantiated
+    again from the same folders and left alive at exit: the reloaded copies are guarded again."""
+    names = name.split(",")
+    first, statuses = _exit_run(names, fmu_dir, work, "first")
+    at_first = _exit_state()
+    for inst in first:
+        inst.close()
+    after_free = _exit_state()
+    _, more = _exit_run(names, fmu_dir, work, "again")
+    return {"statuses": sorted({*statuses, *more}), "first": at_first, "after_free": after_free, **_exit_state()}
+
+
 CASES = {n[5:]: f for n, f in globals().items() if n.startswith("case_")}
 
 if __name__ == "__main__":
@@ -497,7 +556,3 @@ if __name__ == "__main__":
     result = CASES[case](fmu_name, Path(fmu_dir), Path(work_dir))
     sys.stdout.flush()
     print("\n" + json.dumps(result), flush=True)
-    # Leave without interpreter finalisation and C++ static destructors: under load about one
-    # run in 30 with several pythonfmu 0.7.0 instances aborts there ("corrupted double-linked
-    # list", after every FMU was freed), which says nothing about the case (README, known issues).
-    os._exit(0)

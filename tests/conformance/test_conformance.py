@@ -81,7 +81,7 @@ def conformance(fmu_dir, tmp_path_factory):
     """Futures of every planned case, started two at a time after the VesselMotion record."""
     work = tmp_path_factory.mktemp("conformance")
     record = run_worker("record", "VesselMotion", fmu_dir, work)
-    assert "_failure" not in record and record["finite"], record
+    assert "_failure" not in record and record.get("_exit", 0) == 0 and record["finite"], record
     python, env = clean_environment(tmp_path_factory.mktemp("clean-venv"))
     pool = ThreadPoolExecutor(max_workers=2)
     futures: dict[tuple[str, str], Future] = {

@@ -1,4 +1,4 @@
-"""The ``ahc`` part of ``marinefmu bench`` (issue 9): how long the heave-compensation design
+"""The ``ahc`` part of ``marinefmu bench``: how long the heave-compensation design
 loop takes (identify, tune, verify, plots, with the defaults of ``marinefmu design-ahc``), and
 the four-way comparison of the built-in scenario ``ahc`` (its residuals, limit time, wall time
 and real-time factor under the FMPy runner)."""

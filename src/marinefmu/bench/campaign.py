@@ -1,20 +1,20 @@
-"""The ``campaign`` part of ``marinefmu bench`` (issue 10): how a campaign scales on Dask.
+"""The ``campaign`` part of ``marinefmu bench``: how a campaign scales on Dask.
 
 - **Throughput**: the same 8 runs (the ``system`` scenario, :data:`RUN_S` simulated seconds
   each, Hs × Tp × seed) on a local cluster of 1 and of 2 workers, in runs per hour from the
   first submission to the last result; each cluster size :data:`REPEATS` times, alternating,
   and the best of each kept (this shared machine's speed varies by tens of percent from one
-  minute to the next). Goal: 2 workers ≥ 1.8 × 1 worker.
+  minute to the next). Project goal: 2 workers ≥ 1.8 × 1 worker.
 - **Engine overhead per run** (scheduling, serialisation, result transfer, table writing): on
   the 1-worker cluster, the wall time between first submission and last result minus the time
   the worker spent inside the runs (each run's own ``wall_s``), per run; against the wall time
-  of a 10-minute run (the runs' simulation time scaled to 600 s). Goal ≤ 5 %.
+  of a 10-minute run (the runs' simulation time scaled to 600 s). Project goal ≤ 5 %.
 - **Memory per worker**: :data:`MEMORY_RUNS` runs of :data:`MEMORY_RUN_S` s (one seed each) on 2
   workers, about 100 a worker; each run reports its worker's resident memory after it
   (``rss_mb``). Per worker: the growth over its first :data:`WARM_UP` runs (glibc's heap and
   the caches fill: measured in a plain process, the resident set rises for about 20 runs and
   then stays within a few MB over 150), and the growth from then to its last runs (the means of
-  five runs each) with the least-squares slope. Goal: flat, read as at most :data:`FLAT_MB` MB of
+  five runs each) with the least-squares slope. Project goal: flat, read as at most :data:`FLAT_MB` MB of
   growth after the warm-up (the FMUs' own memory goal).
 """
 from __future__ import annotations
@@ -87,8 +87,8 @@ def campaign_bench(fmu_dir: Path, work: Path | None = None) -> dict:
     overhead = (one["wall_s"] - one["runs"] * one["mean_task_s"]) / one["runs"]
     ten_minutes = one["mean_run_s"] / RUN_S * 600.0
     speedup = runs[2]["runs_per_hour"] / one["runs_per_hour"]
-    print(f"  2 workers / 1 worker: {speedup:.2f} (goal >= 1.8); engine overhead {overhead:.3f} s per run, "
-          f"{100 * overhead / ten_minutes:.2f} % of a 10-minute run ({ten_minutes:.0f} s) (goal <= 5 %)")
+    print(f"  2 workers / 1 worker: {speedup:.2f} (project goal >= 1.8); engine overhead {overhead:.3f} s per run, "
+          f"{100 * overhead / ten_minutes:.2f} % of a 10-minute run ({ten_minutes:.0f} s) (project goal <= 5 %)")
 
     mem_spec = parse_spec(_MEMORY.format(duration=MEMORY_RUN_S, runs=MEMORY_RUNS), fmu_dir, "bench memory", check_values=False)
     out = work / "memory"
@@ -105,7 +105,7 @@ def campaign_bench(fmu_dir: Path, work: Path | None = None) -> dict:
                       "rss_mb": rss.round(2).tolist()}
         print(f"  campaign memory, worker {w}: {rss.size} runs, {workers[w]['first_mb']:.1f} MB after its first runs, "
               f"{workers[w]['warm_mb']:.1f} after {WARM_UP}, {workers[w]['last_mb']:.1f} after its last "
-              f"(growth after the warm-up {workers[w]['growth_mb']:+.1f} MB, slope {1000 * slope:.1f} kB/run; goal <= {FLAT_MB:g} MB)")
+              f"(growth after the warm-up {workers[w]['growth_mb']:+.1f} MB, slope {1000 * slope:.1f} kB/run; project goal <= {FLAT_MB:g} MB)")
     flat = all(v["growth_mb"] <= FLAT_MB for v in workers.values())
     shutil.rmtree(work, ignore_errors=True)
     return {"throughput": runs, "speedup_2_over_1": speedup, "speedup_goal": 1.8, "overhead_s_per_run": overhead,

@@ -1,6 +1,6 @@
 """Memory of each FMU under FMPy over a long run and over many instantiate/free cycles.
 
-Part of ``marinefmu bench`` (issue 8: memory must stay flat within 10 MB over 10⁶ steps and
+Part of ``marinefmu bench`` (project goal: memory stays flat within 10 MB over 10⁶ steps and
 over 1,000 instantiate/free cycles). Each measurement runs in a fresh process::
 
     python -m marinefmu.bench.memory steps  FMU_PATH STEPS

@@ -1,4 +1,4 @@
-"""Someone else's data: marinefmu and smsfusion on an OrcaFlex vessel simulation (issue 7).
+"""Someone else's data: marinefmu and smsfusion on an OrcaFlex vessel simulation.
 
 The record (``data/peer/smsfusion_orcaflex/``; from 4Subsea's smsfusion-python repository,
 ``tests/testdata/ains_ahrs_imu.parquet`` at commit 491aa06b, MIT licence, converted to CSV) is
@@ -15,16 +15,17 @@ true initial attitude (and AidedINS from the true position and velocity), as sms
 test on this record does; marinefmu's AttitudeEstimator levels itself from the first 10 s.
 Errors are scored, as smsfusion's test does, from sample 600 (58.6 s) on.
 
-- **Roll and pitch**: :class:`~.estimators.attitude.AttitudeEstimator` against smsfusion's
-  ``VRU`` and ``AHRS`` (the latter also aided by the compass).
-- **Heave** from the accelerometer alone: :class:`~.estimators.heave.HeaveObserver`
-  fed by the AttitudeEstimator's roll and pitch; scored from the time it turns valid (its
-  120 s window) against the true down position minus its record mean. smsfusion has no
-  accelerometer-only heave filter to put beside it.
+- **Roll and pitch**: :class:`~marinefmu.estimators.attitude.estimator.AttitudeEstimator`
+  against smsfusion's ``VRU`` and ``AHRS`` (the latter also aided by the compass).
+- **Heave** from the accelerometer alone:
+  :class:`~marinefmu.estimators.heave.observer.HeaveObserver` fed by the AttitudeEstimator's
+  roll and pitch; scored from the time it turns valid (its 120 s window) against the true down
+  position minus its record mean. smsfusion has no accelerometer-only heave filter to put
+  beside it.
 - **GNSS-aided position** (1 Hz fixes, every 10th sample, as smsfusion's test aids its INS):
-  the fusion filter of :mod:`~.estimators.gnss_fusion` on one receiver
-  (:func:`~.estimators.fusion_runs.fuse_receiver`; the specific force rotated with the
-  AttitudeEstimator's roll and pitch and the compass heading) against smsfusion's
+  the fusion filter of :mod:`~marinefmu.estimators.gnss_fusion` on one receiver
+  (:func:`~marinefmu.estimators.gnss_fusion.runs.fuse_receiver`; the specific force rotated
+  with the AttitudeEstimator's roll and pitch and the compass heading) against smsfusion's
   ``AidedINS`` aided by the same fixes and compass. The fusion's ``q`` and ``q_down`` are not
   tuned on this record: :func:`tune_receiver_q` picks them on a VesselMotion record with the
   same sensors (a grid, the truth of our own simulator) and :data:`RECEIVER_Q` holds its
@@ -157,7 +158,7 @@ def attitude_runs(rec: OrcaflexRecord) -> dict[str, np.ndarray]:
 def heave_run(rec: OrcaflexRecord, roll: np.ndarray, pitch: np.ndarray,
               **params: Any) -> tuple[np.ndarray, np.ndarray]:
     """Heave [m, down] and ``valid`` of marinefmu's HeaveObserver fed by ``roll``/``pitch``
-    (``params``: more :class:`~.estimators.heave.HeaveObserverParams` fields)."""
+    (``params``: more :class:`~marinefmu.estimators.heave.common.HeaveObserverParams` fields)."""
     from ..estimators.heave.common import HeaveObserverParams
     from ..estimators.heave.observer import HeaveObserver
 

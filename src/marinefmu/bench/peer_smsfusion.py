@@ -1,5 +1,5 @@
 """A peer library side by side: smsfusion (4Subsea's marine sensor-fusion library, PyPI) on the
-same sensor records as marinefmu's estimators (issue 7).
+same sensor records as marinefmu's estimators.
 
 :func:`vru_roll_pitch` runs ``smsfusion.VRU`` (a multiplicative extended Kalman filter with
 zero-velocity pseudo-aiding, its vertical reference unit) told the same IMU noise as
@@ -10,10 +10,11 @@ with the truth at t_k (a one-sample shift measures 0.0001° worse on the ``syste
 
 
 :func:`aided_ins_cog` runs ``smsfusion.AidedINS`` (the full aided INS, MEKF) aided at every
-GNSS epoch by what the four antennas give: the COG position (:func:`~.estimators.gnss_fusion.
-antenna_attitude`, as its lever arm from the IMU) and the heading; warm-started from the first
-epoch. Its IMU position is moved to the COG with its own attitude, so it estimates what
-:class:`~.estimators.gnss_fusion.GnssAccFusion` estimates.
+GNSS epoch by what the four antennas give: the COG position
+(:func:`~marinefmu.estimators.gnss_fusion.antenna_attitude.antenna_attitude`, as its lever arm
+from the IMU) and the heading; warm-started from the first epoch. Its IMU position is moved to
+the COG with its own attitude, so it estimates what
+:class:`~marinefmu.estimators.gnss_fusion.filter.GnssAccFusion` estimates.
 
 :func:`compare_attitude` and :func:`compare_gnss_aided` score marinefmu and the peer on one
 VesselMotion record against the truth.

@@ -22,7 +22,12 @@ the class made by that execution, with its methods, stays alive (about 5 KB), an
 the resources folder into ``sys.path`` once more. The model scripts therefore bind the class
 made by their import when they run again (:meth:`SlaveIO.rerun`) instead of making a new
 one, and :class:`SlaveIO` drops repeated ``sys.path`` entries. What remains (the MRO lists
-and class-name strings) is measured by ``marinefmu bench`` (README, "FMU contract").
+and class-name strings) is measured by ``marinefmu bench`` (the FMU contract page).
+
+**Process exit.** At ``exit()`` pythonfmu 0.7.0's library writes into memory its own static
+destructor has freed. Every :class:`SlaveIO` therefore arms :func:`marinefmu.fmu.host_exit.guard`
+for the library it runs in (once per loaded copy), which empties that pointer first, so any
+host, Python or not, exits cleanly (``host_exit``'s module doc has the mechanism).
 """
 from __future__ import annotations
 
@@ -39,6 +44,7 @@ from pythonfmu.fmi2slave import Fmi2Slave
 
 from ..errors import MarineFmuError
 from ..variables import Variable
+from . import host_exit
 
 M = TypeVar("M")
 _FMI_TYPES = {"real": Real, "integer": Integer, "boolean": Boolean, "string": String}
@@ -80,6 +86,7 @@ class SlaveIO:
     def __init__(self, slave: Fmi2Slave, parameters: Sequence[Variable], outputs: Sequence[Variable],
                  boolean_outputs: Sequence[Variable] = (), inputs: Sequence[Variable] = ()) -> None:
         _drop_repeated_sys_path()
+        host_exit.guard(getattr(slave, "resources", None))
         self.slave = slave
         self.params: dict[str, Any] = {v.name: v.default for v in parameters}
         self.inputs: dict[str, Any] = {v.name: v.default for v in inputs}
