@@ -22,7 +22,7 @@ demo: fmus
 # Two test workers (pytest-xdist), one per core of the CI machine; a file's tests stay together so
 # its module fixtures (the conformance runs, the long co-simulations) are built once.
 test: fmus
-	$(PY) -m pytest -q -n 2 --dist loadfile
+	$(PY) -m pytest -q -n 2 --dist loadfile --durations=20
 
 bench: fmus
 	$(VENV)/bin/marinefmu bench --out bench
