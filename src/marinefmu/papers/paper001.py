@@ -26,6 +26,7 @@ from scipy import signal
 from ..estimators.gnss_fusion.runs import fuse
 from ..estimators.gnss_fusion.filter import COAST_AFTER, GnssAccFusionParams
 from ..sea.motion_model import VesselMotionParams, simulate_record, stack
+from ..sea.sensors import IMU_GRADES
 from ..sea.vessel import preset_raos, save_rao_csv
 
 DT = 0.01
@@ -251,12 +252,14 @@ LATE_DROPOUTS = tuple((start + 900.0, seed) for start, seed in DROPOUTS)
 LONG_DROPOUTS = tuple((270.0, seed) for seed in range(1, 5))
 
 
-#: A tactical-grade gyro (bias instability [rad/s], white-noise density [rad/s/√Hz]): 1e-5 rad/s
-#: is 2 °/h, 1.5e-5 rad/s/√Hz an angle random walk of 0.05 °/√h (fibre-optic gyros of the class
-#: used on survey vessels), against VesselMotion's default MEMS gyro of 5e-5 and 5e-5 (10 °/h,
-#: 0.17 °/√h). For :func:`dropouts` with ``gyro``: the tail of the 30 s dropout is the coast's
-#: tilt estimate, which the gyro's bias wander and angle random walk turn through the gap.
-TACTICAL_GYRO = (1e-5, 1.5e-5)
+#: A tactical-grade gyro (bias instability [rad/s], white-noise density [rad/s/√Hz]): the gyro of
+#: VesselMotion's ``imu.grade = tactical`` (:data:`~marinefmu.sea.sensors.IMU_GRADES`), 1e-5 rad/s
+#: = 2 °/h and 1.5e-5 rad/s/√Hz = an angle random walk of 0.05 °/√h, against the default MEMS
+#: gyro's 5e-5 and 5e-5 (10 °/h, 0.17 °/√h). For :func:`dropouts` with ``gyro``: the tail of the
+#: 30 s dropout is the coast's tilt estimate, which the gyro's bias wander and angle random walk
+#: turn through the gap. Only the gyro's figures replace the default's here (the grade's
+#: accelerometer and bias time constant do not), as in the dropout study's decision record.
+TACTICAL_GYRO = (IMU_GRADES["tactical"].gyro_bias_instability, IMU_GRADES["tactical"].gyro_noise)
 
 
 def dropout_record(start: float, seed: int, duration: float = 30.0,

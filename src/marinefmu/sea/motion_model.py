@@ -36,11 +36,12 @@ import numpy as np
 from ..errors import ParameterError, check_choice, check_int, check_vector
 from ..frames import attitude_kinematics, rigid_point_operator, specific_force
 from ..variables import Variable, real, resolve, vec
-from .sensors import ANTENNAS, Gnss, GnssParams, Imu, ImuParams
-from .vessel import PRESETS, MotionSeries, RaoTable, check_speed, load_rao_csv, preset_raos
+from .sensors import ANTENNAS, GRADE_FIGURES, IMU_GRADES, Gnss, GnssParams, Imu, ImuParams
+from .vessel import PRESET_NAMES, MotionSeries, RaoTable, check_speed, load_rao_csv, preset_raos
 from .waves import SPECTRA, SeaState, realise
 
 MODES = {0: "RAO response about the COG", 1: "independent rotations about vessel.cr"}
+_MEMS = IMU_GRADES["mems"]
 
 PARAMETERS: list[Variable] = [
     real("sea.hs", 2.5, "m", "Significant wave height Hs, 0 < Hs <= 30"),
@@ -53,19 +54,25 @@ PARAMETERS: list[Variable] = [
     Variable("sea.components", "integer", 200, "", "Number of regular wave components, 10..5000"),
     real("sea.omega_min", 0.0, "rad/s", "Lowest wave frequency; 0 = 0.5 x peak frequency"),
     real("sea.omega_max", 0.0, "rad/s", "Highest wave frequency; 0 = 5 x peak frequency"),
-    Variable("vessel.preset", "string", "polar_supply", "", f"Built-in hull: one of {', '.join(PRESETS)}"),
+    Variable("vessel.preset", "string", "polar_supply", "", f"Built-in hull: one of {', '.join(PRESET_NAMES)}"),
     Variable("vessel.rao_file", "string", "", "", "RAO table CSV (overrides the preset's RAOs when not empty)"),
     real("vessel.speed", 0.0, "m/s", "Forward speed (encounter frequency), 0..20"),
     Variable("vessel.mode", "integer", 0, "", "0 RAO response about the COG, 1 rotations independent of translations about vessel.cr"),
     *vec("vessel.cr", "xyz", 0.0, "m", "Rotation centre for vessel.mode = 1, relative to the COG, body frame"),
     *vec("imu", "xyz", 0.0, "m", "IMU lever arm relative to the COG, body frame"),
-    real("imu.acc_noise", 7e-4, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, 0..1"),
-    real("imu.gyro_noise", 5e-5, "rad/s/sqrt(Hz)", "Gyro white-noise density, 0..1"),
+    Variable("imu.grade", "string", "mems", "",
+             f"IMU class: one of {', '.join(IMU_GRADES)}; sets imu.acc_noise, imu.gyro_noise, "
+             "imu.acc_bias_instability, imu.gyro_bias_instability and imu.bias_tau, each of which, set to other than "
+             "its default (the mems figure), replaces the grade's"),
+    real("imu.acc_noise", _MEMS.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, 0..1 (left at its default: imu.grade's)"),
+    real("imu.gyro_noise", _MEMS.gyro_noise, "rad/s/sqrt(Hz)", "Gyro white-noise density, 0..1 (left at its default: imu.grade's)"),
     *vec("imu.acc_bias", "xyz", 0.0, "m/s2", "Accelerometer constant bias, body frame"),
     *vec("imu.gyro_bias", "xyz", 0.0, "rad/s", "Gyro constant bias, body frame"),
-    real("imu.acc_bias_instability", 5e-4, "m/s2", "Accelerometer Gauss-Markov bias standard deviation, 0..1"),
-    real("imu.gyro_bias_instability", 5e-5, "rad/s", "Gyro Gauss-Markov bias standard deviation, 0..1"),
-    real("imu.bias_tau", 50.0, "s", "Gauss-Markov bias correlation time, 0.1..1e6"),
+    real("imu.acc_bias_instability", _MEMS.acc_bias_instability, "m/s2",
+         "Accelerometer Gauss-Markov bias standard deviation, 0..1 (left at its default: imu.grade's)"),
+    real("imu.gyro_bias_instability", _MEMS.gyro_bias_instability, "rad/s",
+         "Gyro Gauss-Markov bias standard deviation, 0..1 (left at its default: imu.grade's)"),
+    real("imu.bias_tau", _MEMS.bias_tau, "s", "Gauss-Markov bias correlation time, 0.1..1e6 (left at its default: imu.grade's)"),
     Variable("sensors.seed", "integer", 1, "", "Seed of the sensor noise (IMU and GNSS streams)"),
     real("gnss.rate", 5.0, "Hz", "GNSS fix rate, 0.1..100"),
     real("gnss.sigma_h", 0.01, "m", "GNSS horizontal noise standard deviation, 0..100"),
@@ -129,7 +136,7 @@ class VesselMotionParams:
     sensor_seed: int = 1
 
     def __post_init__(self) -> None:
-        check_choice("vessel.preset", self.preset, PRESETS)
+        check_choice("vessel.preset", self.preset, PRESET_NAMES)
         if not isinstance(self.rao_file, str):
             raise ParameterError(f"vessel.rao_file must be a path string, got {self.rao_file!r}")
         check_speed(self.speed)
@@ -157,12 +164,8 @@ class VesselMotionParams:
             heading=v["sea.heading"], spreading=v["sea.spreading"], seed=v["sea.seed"],
             n_components=v["sea.components"], omega_min=v["sea.omega_min"], omega_max=v["sea.omega_max"],
         )
-        imu = ImuParams(
-            lever_arm=xyz("imu"), acc_noise=v["imu.acc_noise"], gyro_noise=v["imu.gyro_noise"],
-            acc_bias=xyz("imu.acc_bias"), gyro_bias=xyz("imu.gyro_bias"),
-            acc_bias_instability=v["imu.acc_bias_instability"], gyro_bias_instability=v["imu.gyro_bias_instability"],
-            bias_tau=v["imu.bias_tau"],
-        )
+        imu = ImuParams.from_grade(v["imu.grade"], lever_arm=xyz("imu"), acc_bias=xyz("imu.acc_bias"),
+                                   gyro_bias=xyz("imu.gyro_bias"), **grade_overrides(v))
         gnss = GnssParams(
             antennas=tuple(xyz(f"gnss.ant{i + 1}") for i in range(ANTENNAS)), rate=v["gnss.rate"],
             sigma_h=v["gnss.sigma_h"], sigma_v=v["gnss.sigma_v"],
@@ -172,6 +175,15 @@ class VesselMotionParams:
         return cls(sea=sea, preset=v["vessel.preset"], rao_file=v["vessel.rao_file"], speed=v["vessel.speed"],
                    mode=v["vessel.mode"], cr=xyz("vessel.cr"), imu=imu, gnss=gnss, point=xyz("point"),
                    sensor_seed=v["sensors.seed"])
+
+
+def grade_overrides(values: dict[str, Any]) -> dict[str, float]:
+    """The ``imu.*`` error figures of ``values`` (FMI names) that replace those of ``imu.grade``:
+    each set to other than its default, the ``mems`` figure (an FMI parameter cannot tell "set"
+    from "left at its default", so a figure equal to the mems one keeps the grade's; to mix that
+    figure with another grade's, set ``imu.grade = mems`` and all five)."""
+    defaults = {v.name: v.default for v in PARAMETERS}
+    return {f: values[f"imu.{f}"] for f in GRADE_FIGURES if values.get(f"imu.{f}", defaults[f"imu.{f}"]) != defaults[f"imu.{f}"]}
 
 
 @dataclass(frozen=True)

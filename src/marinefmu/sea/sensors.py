@@ -6,8 +6,13 @@ Gauss–Markov bias (bias instability) with stationary standard deviation σ_b a
 time τ, discretised exactly: b_{k+1} = φ b_k + σ_b √(1−φ²) w_k, φ = e^{−Δt/τ}. The
 Gauss–Markov state starts from its stationary distribution, so the bias is present at t = 0.
 
-Defaults are a marine MEMS motion sensor: accelerometer 0.0007 m/s²/√Hz, bias 0.0005 m/s²;
-gyro 5e-5 rad/s/√Hz, bias 5e-5 rad/s; bias correlation time 50 s.
+Sensor grades (:data:`IMU_GRADES`): the five random-error figures of three classes of unit,
+``mems`` (the defaults: accelerometer 0.0007 m/s²/√Hz, bias 0.0005 m/s²; gyro 5e-5 rad/s/√Hz,
+bias 5e-5 rad/s; bias correlation time 50 s), ``tactical`` and ``mru``; each grade's sources
+are in its ``source``. A datasheet's figures map onto the model as: noise density N = angle
+random walk [°/√h] / 60 (gyro, then to rad/s/√Hz) or velocity random walk [m/s/√h] / 60
+(accelerometer); the Gauss–Markov σ_b = the in-run bias stability (bias instability); τ = the
+averaging time at which the class's Allan deviation reaches that floor.
 
 GNSS: each antenna reports its NED position at epochs t_k = k / rate with independent white
 noise σ_h (north, east) and σ_v (down), default RTK 1 cm / 1.5 cm; an optional dropout window
@@ -18,12 +23,77 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError, check_range, check_vector
+from ..errors import ParameterError, check_choice, check_range, check_vector
 
 ANTENNAS = 4
+
+#: Conversions for the grades' sources: 1 µg [m/s²], 1 °/h [rad/s], and an angle random walk of
+#: 1 °/√h as a white-noise density [rad/s/√Hz] (a velocity random walk of 1 m/s/√h is 1/60 m/s²/√Hz).
+MICRO_G = 9.80665e-6
+DEG_PER_HOUR = math.radians(1.0) / 3600.0
+DEG_PER_SQRT_HOUR = math.radians(1.0) / 60.0
+
+
+@dataclass(frozen=True)
+class ImuGrade:
+    """The random-error figures of one class of IMU (:data:`IMU_GRADES`).
+
+    Parameters
+    ----------
+    acc_noise : float
+        Accelerometer white-noise density [m/s²/√Hz] (velocity random walk).
+    acc_bias_instability : float
+        Accelerometer Gauss–Markov bias σ [m/s²] (in-run bias stability).
+    gyro_noise : float
+        Gyro white-noise density [rad/s/√Hz] (angle random walk).
+    gyro_bias_instability : float
+        Gyro Gauss–Markov bias σ [rad/s] (in-run bias stability).
+    bias_tau : float
+        Gauss–Markov correlation time of both biases [s].
+    source : str
+        Where the figures come from, and what they mean on the datasheets.
+    """
+
+    acc_noise: float
+    acc_bias_instability: float
+    gyro_noise: float
+    gyro_bias_instability: float
+    bias_tau: float
+    source: str
+
+
+#: The error figures a grade sets (the names of :class:`ImuParams` and of ``imu.*`` in VesselMotion).
+GRADE_FIGURES = ("acc_noise", "acc_bias_instability", "gyro_noise", "gyro_bias_instability", "bias_tau")
+
+#: IMU classes by name (``imu.grade`` of VesselMotion). ``mems`` is the default of every figure.
+IMU_GRADES: dict[str, ImuGrade] = {
+    "mems": ImuGrade(
+        acc_noise=7e-4, acc_bias_instability=5e-4, gyro_noise=5e-5, gyro_bias_instability=5e-5, bias_tau=50.0,
+        source="An industrial MEMS motion sensor (VesselMotion's figures since 0.1): accelerometer 71 µg/√Hz, "
+               "bias instability 51 µg; gyro angle random walk 0.17 °/√h, bias instability 10 °/h; τ 50 s. "
+               "Of the class of the Xsens MTi-1 datasheet (gyro bias instability 10 °/h, noise "
+               "0.007 °/s/√Hz = 0.42 °/√h; accelerometer 120 µg/√Hz), with lower noise."),
+    "tactical": ImuGrade(
+        acc_noise=5e-4, acc_bias_instability=25 * MICRO_G, gyro_noise=1.5e-5, gyro_bias_instability=1e-5,
+        bias_tau=100.0,
+        source="A tactical-grade IMU: gyro bias instability 2 °/h and angle random walk 0.05 °/√h (paper 001's "
+               "dropout study, on the cautious side of the class: Honeywell HG4930 datasheet 0.25 °/h and "
+               "0.04 °/√h, Analog Devices ADIS16495 0.8 °/h and 0.09 °/√h); accelerometer velocity random "
+               "walk 0.03 m/s/√h (51 µg/√Hz) and bias instability 25 µg (HG4930); τ 100 s."),
+    "mru": ImuGrade(
+        acc_noise=15 * MICRO_G, acc_bias_instability=5 * MICRO_G, gyro_noise=0.01 * DEG_PER_SQRT_HOUR,
+        gyro_bias_instability=0.05 * DEG_PER_HOUR, bias_tau=300.0,
+        source="A survey motion reference unit with fibre-optic or high-end MEMS gyros, stated roll and pitch "
+               "0.01 ° or better (Kongsberg Seatex MRU 5+ datasheet: 0.008 ° RMS; iXblue Octans: 0.01 °; "
+               "SBG Apogee: 0.008 °): gyro bias instability 0.05 °/h and angle random walk 0.01 °/√h; "
+               "accelerometer 15 µg/√Hz and bias instability 5 µg (SBG Apogee-class accelerometers, "
+               "14 µg/√Hz and a few µg); τ 300 s."),
+}
+_MEMS = IMU_GRADES["mems"]
 
 
 @dataclass(frozen=True)
@@ -45,13 +115,13 @@ class ImuParams:
     """
 
     lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    acc_noise: float = 7e-4
-    gyro_noise: float = 5e-5
+    acc_noise: float = _MEMS.acc_noise
+    gyro_noise: float = _MEMS.gyro_noise
     acc_bias: tuple[float, float, float] = (0.0, 0.0, 0.0)
     gyro_bias: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    acc_bias_instability: float = 5e-4
-    gyro_bias_instability: float = 5e-5
-    bias_tau: float = 50.0
+    acc_bias_instability: float = _MEMS.acc_bias_instability
+    gyro_bias_instability: float = _MEMS.gyro_bias_instability
+    bias_tau: float = _MEMS.bias_tau
 
     def __post_init__(self) -> None:
         check_vector("imu.{x,y,z}", self.lever_arm, unit="m")
@@ -64,6 +134,19 @@ class ImuParams:
         check_range("imu.acc_bias_instability", self.acc_bias_instability, lo=0.0, hi=1.0, unit="m/s2")
         check_range("imu.gyro_bias_instability", self.gyro_bias_instability, lo=0.0, hi=1.0, unit="rad/s")
         check_range("imu.bias_tau", self.bias_tau, lo=0.1, hi=1e6, unit="s")
+
+    @classmethod
+    def from_grade(cls, grade: str = "mems", **fields: Any) -> "ImuParams":
+        """The error model of ``grade`` (:data:`IMU_GRADES`), with any field given here replacing
+        the grade's: ``ImuParams.from_grade("mru", lever_arm=(50.0, 0.0, -10.0), acc_noise=0.0)``.
+
+        Raises
+        ------
+        ParameterError
+            For a grade that does not exist (naming the grades) or an invalid field value.
+        """
+        g = IMU_GRADES[check_choice("imu.grade", grade, IMU_GRADES)]
+        return cls(**{**{name: getattr(g, name) for name in GRADE_FIGURES}, **fields})
 
 
 class Imu:
@@ -99,6 +182,35 @@ class Imu:
         true[:3] = f_true
         true[3:] = w_true
         return true + self._const + self.gm_bias + self._density / math.sqrt(dt) * w[6:]
+
+    def measure_many(self, f_true: np.ndarray, w_true: np.ndarray, dt: float) -> np.ndarray:
+        """:meth:`measure` at each of n steps of ``dt`` [s], vectorised: the same numbers, drawn
+        from the generator in the same order, as n calls would return.
+
+        Parameters
+        ----------
+        f_true, w_true : numpy.ndarray
+            (n, 3) true specific force [m/s², b] and angular rate [rad/s, b].
+        dt : float
+            Step [s].
+
+        Returns
+        -------
+        numpy.ndarray
+            (n, 6) measured [f_b (m/s²), ω_b (rad/s)]; the bias is left at its value after the
+            last step.
+        """
+        from scipy.signal import lfilter
+
+        true = np.column_stack([f_true, w_true]).astype(float)
+        phi = math.exp(-dt / self.params.bias_tau)
+        w = self._rng.standard_normal((len(true), 12))
+        # b_k = φ b_{k−1} + σ_b √(1−φ²) w_k from b_{−1} = the current bias (lfilter's state is φ b_{−1})
+        gm = lfilter([1.0], [1.0, -phi], self._sigma_b * math.sqrt(1.0 - phi * phi) * w[:, :6], axis=0,
+                     zi=(phi * self.gm_bias)[None, :])[0]
+        if len(gm):
+            self.gm_bias = gm[-1].copy()
+        return true + self._const + gm + self._density / math.sqrt(dt) * w[:, 6:]
 
     def get_state(self) -> dict:
         """JSON-serialisable state (generator and bias)."""
