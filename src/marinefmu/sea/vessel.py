@@ -11,7 +11,9 @@ therefore hold the RAOs for the vessel speed it is used with.
 Built-in presets are *plausible*, not hydrodynamic results: a closed-form strip model of a
 box-like hull (:func:`parametric_raos`) with the natural periods and damping ratios given
 in :data:`PRESETS` (sources in each preset's ``source`` text). For real work, bring RAOs
-from WAMIT, OrcaFlex or Capytaine as a CSV file (:func:`load_rao_csv`).
+from WAMIT, OrcaFlex or Capytaine as a CSV file (:func:`load_rao_csv`). The BEM presets
+(:data:`BEM_PRESETS`) are such files, computed with Capytaine by ``marinefmu hydro``
+(:mod:`marinefmu.sea.hydro`) and shipped under ``marinefmu/data/hydro``.
 """
 from __future__ import annotations
 
@@ -224,9 +226,26 @@ def parametric_raos(hull: HullParticulars, name: str, speed: float = 0.0) -> Rao
     return RaoTable(omega=omega, heading=heading, rao=rao, name=name)
 
 
+#: BEM presets: zero-speed RAO tables from Capytaine (``marinefmu hydro --preset all``), read at
+#: run time from ``marinefmu/data/hydro/<name>.csv``.
+BEM_PRESETS = ("box_barge", "polar_supply_bem", "semisub_bem", "research36_bem")
+#: Every name ``vessel.preset`` takes: the closed-form presets, then the BEM presets.
+PRESET_NAMES = (*PRESETS, *BEM_PRESETS)
+
+
+def bem_preset_path(name: str) -> Path:
+    """The shipped CSV file of BEM preset ``name`` (inside the package, for the FMU bundle)."""
+    return Path(__file__).resolve().parent.parent / "data" / "hydro" / f"{name}.csv"
+
+
 def preset_raos(name: str, speed: float = 0.0) -> RaoTable:
-    """RAO table of a built-in preset (``"semisub"``, ``"polar_supply"``, ``"research36"``)."""
-    check_choice("vessel.preset", name, PRESETS)
+    """RAO table of a built-in preset: closed-form (``"semisub"``, ``"polar_supply"``,
+    ``"research36"``, at forward speed ``speed`` [m/s]) or BEM (:data:`BEM_PRESETS`, computed
+    for zero speed: ``speed`` only shifts the encounter frequency, as for a ``vessel.rao_file``)."""
+    check_choice("vessel.preset", name, PRESET_NAMES)
+    if name in BEM_PRESETS:
+        t = load_rao_csv(bem_preset_path(name))
+        return RaoTable(omega=t.omega, heading=t.heading, rao=t.rao, name=name)
     return parametric_raos(PRESETS[name], name, speed)
 
 
