@@ -19,6 +19,7 @@ from marinefmu import (
     GnssAccFusion, GnssAccFusionParams, HeaveObserver, HeaveObserverParams, VesselMotion, VesselMotionParams,
 )
 from marinefmu.estimators.heave.bank import OscillatorBankHeave
+from marinefmu.sea.recording.player import SensorRecording, SensorRecordingParams
 from marinefmu.estimators.heave.highpass import HighpassHeave
 from marinefmu.estimators.heave.observer import build_heave_model
 from marinefmu.estimators.heave.wiener import WienerHeave
@@ -35,7 +36,11 @@ MODELS = {
     "HeaveObserver": (HeaveObserver, HeaveObserverParams),
     "AhcWinch": (AhcWinch, AhcWinchParams),
     "AhcController": (AhcController, AhcControllerParams),
+    "SensorRecording": (SensorRecording, SensorRecordingParams),
 }
+# Defaults that cannot play (a recording needs its file and mapping): the example MRU export
+EXAMPLE_PARAMS = {"SensorRecording": {"file": str(ROOT / "examples/recordings/generic_mru_sample.csv"),
+                                      "mapping": str(ROOT / "examples/recordings/generic_mru.toml")}}
 
 # HeaveObserverParams.model -> the class that does the work (estimators.heave.observer's table)
 HEAVE_MODELS = {"wiener": WienerHeave, "band": OscillatorBankHeave, "peaks": OscillatorBankHeave,
@@ -64,11 +69,12 @@ def test_every_fmu_has_a_model_of_its_name_with_params_beside_it():
 @pytest.mark.parametrize("name", MODELS)
 def test_each_model_built_from_its_default_params_is_an_estimator(name):
     model, params = MODELS[name]
-    m = model(params())
+    given = EXAMPLE_PARAMS.get(name, {})
+    m = model(params(**given))
     assert isinstance(m, Estimator)
     for method in ("reset", "step", "get_state", "set_state"):
         assert callable(getattr(m, method)), method
-    assert m.params == params()
+    assert m.params == params(**given)
     assert dataclasses.is_dataclass(m.params) and type(m.params).__dataclass_params__.frozen
     json.dumps(m.get_state())   # what the FMU's state carries
 

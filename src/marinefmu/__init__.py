@@ -21,7 +21,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 # public name -> module that defines it
 _PUBLIC: dict[str, str] = {
@@ -42,6 +42,8 @@ _PUBLIC: dict[str, str] = {
     "AhcWinchParams": "marinefmu.ahc.winch",
     "AhcController": "marinefmu.ahc.controller",
     "AhcControllerParams": "marinefmu.ahc.controller",
+    "SensorRecording": "marinefmu.sea.recording.player",
+    "SensorRecordingParams": "marinefmu.sea.recording.player",
     "Estimator": "marinefmu.estimators.protocol",
     "SystemRunner": "marinefmu.cosim.system",
     "load_scenario": "marinefmu.cosim.scenarios",

@@ -13,6 +13,10 @@ Examples
     marinefmu example paper001-fig7 --out results/examples
     marinefmu design-ahc ahc --out results/ahc_design --write
     marinefmu campaign examples/campaigns/scatter.toml --workers 2
+    marinefmu hydro --preset all --out src/marinefmu/data/hydro --plots docs
+    marinefmu record system --duration 600 --out results/rec/system.csv
+    marinefmu replay results/rec/system.csv --mapping results/rec/system.toml --estimators attitude,heave
+    marinefmu build-recording results/rec/system.csv --mapping results/rec/system.toml -o system_rec.fmu
 """
 from __future__ import annotations
 
@@ -261,6 +265,73 @@ def _cmd_campaign(args: argparse.Namespace) -> int:
     return 0 if outcome.failed == 0 else 1
 
 
+def _cmd_hydro(args: argparse.Namespace) -> int:
+    from .sea.hydro.command import run
+
+    return run(args)
+
+
+def _cmd_record(args: argparse.Namespace) -> int:
+    from .cosim.record import record
+
+    r = record(args.scenario, args.out, args.duration, component=args.component, progress=not args.no_progress)
+    print(f"record: {r.component} of scenario {args.scenario}, {r.rows:,} rows at {r.step:g} s")
+    print(f"  recording {r.csv}\n  mapping   {r.mapping}")
+    return 0
+
+
+def _set_values(items: list[str]) -> dict:
+    out = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or "." not in key:
+            raise MarineFmuError(f"--set {item!r} must be component.parameter=value")
+        for cast in (int, float):
+            try:
+                out[key] = cast(value)
+                break
+            except ValueError:
+                continue
+        else:
+            out[key] = {"true": True, "false": False}.get(value.lower(), value)
+    return out
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    from .analysis.replay_report import replay_and_report
+    from .cosim.replay import plan_replay
+
+    fmu_dir = _fmu_dir(args.fmus)
+    plan = plan_replay(args.record, args.mapping, args.estimators, imu=args.imu, point=args.point, step=args.step,
+                       duration=args.duration, start=args.start, parameters=_set_values(args.set))
+    s = plan.summary
+    print(f"replay {args.record}: {s.rows:,} rows, {s.duration:.6g} s; estimators {', '.join(plan.estimators)}; "
+          f"{plan.duration:.6g} s at {plan.system.step:.6g} s")
+    for group in s.samples:
+        print(f"  {group:12s} {s.samples[group]:>10,} samples, {s.bad[group]:,} bad, {s.gaps[group]:,} gap(s) > max_gap")
+    for note in plan.notes:
+        print(f"  note: {note}")
+    out = Path(args.out or f"results/replay/{Path(args.record).stem}")
+    r = replay_and_report(plan, fmu_dir, out, progress=False if args.no_progress else None)
+    print(f"  ran in {r['wall_s']:.1f} s; results {r['npy']}" + (f", {r['csv']}" if r["csv"] else ""))
+    for name, sc in r["scores"].items():
+        print(f"  {name:24s} RMS {sc['rms']:.4g} {sc['unit']} against the record's reference, lag {sc['lag_s']:.4g} s "
+              f"(at lag 0: {sc['rms_lag0']:.4g} {sc['unit']})")
+    for group, n, bad, gaps, steps, _ in r["validity"]:
+        if steps:
+            print(f"  {group}: valid false on {steps:,} step(s)")
+    print(f"  report {r['report']}")
+    return 0
+
+
+def _cmd_build_recording(args: argparse.Namespace) -> int:
+    from .fmu.recording_build import build_recording
+
+    fmu = build_recording(args.record, args.mapping, args.output)
+    print(f"build-recording: {fmu} (record and mapping bundled, validated)")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``marinefmu`` console script."""
     parser = argparse.ArgumentParser(prog="marinefmu", description="Marine motion estimation FMUs: build, simulate, benchmark.")
@@ -321,6 +392,43 @@ def main(argv: list[str] | None = None) -> int:
     e.add_argument("--list", action="store_true", help="list the examples")
     e.add_argument("--out", default="results/examples", help="folder for plots (default results/examples)")
     e.set_defaults(func=_cmd_example)
+    from .sea.hydro.command import add_arguments as _hydro_arguments
+
+    h = sub.add_parser("hydro", help="RAOs of a hull from the BEM solver Capytaine (pip install marinefmu[hydro]): "
+                                     "writes the RAO CSV vessel.rao_file reads, and a plot")
+    _hydro_arguments(h)
+    h.set_defaults(func=_cmd_hydro)
+    r = sub.add_parser("record", help="write a scenario's VesselMotion run as a recording (CSV) plus its mapping "
+                                      "sidecar (TOML), truth as ref.*")
+    r.add_argument("scenario", help="scenario TOML file or built-in name, e.g. system")
+    r.add_argument("--duration", type=float, help="simulated time [s] (default: the scenario's)")
+    r.add_argument("--out", required=True, help="the CSV to write (the sidecar goes beside it as .toml)")
+    r.add_argument("--component", help="the VesselMotion component to record (default the first)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.set_defaults(func=_cmd_record)
+    p = sub.add_parser("replay", help="run a recording through the estimator FMUs; results and an HTML report that "
+                                      "scores the estimates against the record's ref.* signals")
+    p.add_argument("record", help="the recorded file (CSV, CSV.gz or Parquet)")
+    p.add_argument("--mapping", required=True, help="its mapping sidecar (TOML)")
+    p.add_argument("--estimators", default="attitude,heave",
+                   help="comma-separated: attitude, reconstruction, fusion, cr, heave (default attitude,heave)")
+    p.add_argument("--imu", help="IMU lever arm x,y,z [m] relative to the COG, body frame (default the mapping's)")
+    p.add_argument("--point", help="monitoring point x,y,z [m] relative to the COG, body frame (default the mapping's)")
+    p.add_argument("--step", type=float, help="co-simulation step [s] (default the record's mean interval)")
+    p.add_argument("--duration", type=float, help="simulated time [s] (default the record's length)")
+    p.add_argument("--start", type=float, default=0.0, help="offset into the record [s] (default 0)")
+    p.add_argument("--set", action="append", default=[], metavar="COMP.PARAM=VALUE",
+                   help="an estimator parameter, e.g. --set att.acc_noise=0.002 (repeatable)")
+    p.add_argument("--out", help="output folder (default results/replay/<record name>)")
+    p.add_argument("--fmus", help="folder holding the FMUs (default: build into the checkout's fmus/)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_replay)
+    g = sub.add_parser("build-recording", help="a self-contained SensorRecording FMU with the record and its "
+                                               "mapping bundled (compressed) in its resources")
+    g.add_argument("record", help="the recorded file (CSV, CSV.gz or Parquet)")
+    g.add_argument("--mapping", required=True, help="its mapping sidecar (TOML)")
+    g.add_argument("-o", "--output", required=True, help="the FMU to write, NAME.fmu")
+    g.set_defaults(func=_cmd_build_recording)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:

@@ -30,6 +30,16 @@ Errors are scored, as smsfusion's test does, from sample 600 (58.6 s) on.
   tuned on this record: :func:`tune_receiver_q` picks them on a VesselMotion record with the
   same sensors (a grid, the truth of our own simulator) and :data:`RECEIVER_Q` holds its
   result, checked by a test.
+
+**Through the FMUs** (:func:`fmu_runs`, ``compare_orcaflex(fmu_dir=…)``): the record is played by
+the SensorRecording FMU (mapping :data:`MAPPING`, the worked example
+``examples/recordings/orcaflex.toml``) into the AttitudeEstimator and HeaveObserver FMUs, wired
+as ``marinefmu replay`` wires them; the one-receiver fusion, which needs the specific force
+rotated by the estimated attitude and the compass (no FMU does that rotation), runs in-process
+on what the recording FMU and the AttitudeEstimator FMU output. The attitude and the fusion are
+then the in-process figures exactly; the heave differs in the last digits, because under the
+co-simulation's one-step coupling the HeaveObserver gets the roll and pitch of the previous
+sample (in-process: of the same sample).
 """
 from __future__ import annotations
 
@@ -83,6 +93,36 @@ class OrcaflexRecord:
     euler: np.ndarray
     gnss: np.ndarray
     heading: np.ndarray
+
+
+#: The record's sample rate [Hz] (its stamps are rounded to 1 ms).
+RATE = 10.24
+#: The record's mapping sidecar (as ``examples/recordings/orcaflex.toml``, which a test compares).
+MAPPING = """[time]
+column = "time"
+unit = "s"
+rate = 10.24
+[imu]
+max_gap = 0.25
+acc = { x = "Ax_meas", y = "Ay_meas", z = "Az_meas", unit = "m/s2" }
+gyro = { x = "Gx_meas", y = "Gy_meas", z = "Gz_meas", unit = "deg/s" }
+[gnss]
+max_gap = 0.25
+ant1 = { n = "X_meas", e = "Y_meas", d = "Z_meas", unit = "m" }
+[heading]
+column = "Gamma_meas"
+unit = "deg"
+[ref]
+max_gap = 0.25
+roll = { column = "Alpha", unit = "deg" }
+pitch = { column = "Beta", unit = "deg" }
+yaw = { column = "Gamma", unit = "deg" }
+heave = { column = "Z", unit = "m" }
+imu = { n = "X", e = "Y", d = "Z", unit = "m" }
+imu_vel = { n = "VX", e = "VY", d = "VZ", unit = "m/s" }
+rate = { x = "Gx", y = "Gy", z = "Gz", unit = "deg/s" }
+imu_f = { x = "Ax", y = "Ay", z = "Az", unit = "m/s2" }
+"""
 
 
 def data_file() -> Path:
@@ -229,8 +269,98 @@ def _rms(e: np.ndarray) -> np.ndarray:
     return np.sqrt(np.mean(e ** 2, axis=0))
 
 
-def compare_orcaflex(rec: OrcaflexRecord | None = None) -> dict[str, dict[str, float]]:
+@dataclass(frozen=True)
+class FmuRuns:
+    """What the FMU path (:func:`fmu_runs`) gives, one row per sample of the record.
+
+    Attributes
+    ----------
+    roll, pitch : numpy.ndarray
+        (N,) the AttitudeEstimator FMU's roll and pitch after each sample [rad].
+    heave, heave_valid, heave_band, heave_band_valid : numpy.ndarray
+        (N,) the HeaveObserver FMUs' heave [m, down] and valid (default model and ``band``).
+    acc, gnss : numpy.ndarray
+        (N, 3) specific force [m/s², body] and position [m, NED] as the recording FMU played them.
+    heading : numpy.ndarray
+        (N,) the compass [rad] as played.
+    """
+
+    roll: np.ndarray
+    pitch: np.ndarray
+    heave: np.ndarray
+    heave_valid: np.ndarray
+    heave_band: np.ndarray
+    heave_band_valid: np.ndarray
+    acc: np.ndarray
+    gnss: np.ndarray
+    heading: np.ndarray
+
+
+def fmu_runs(fmu_dir: str | Path, rec: OrcaflexRecord | None = None, path: str | Path | None = None,
+             band: bool = True) -> FmuRuns:
+    """Play the record through the SensorRecording, AttitudeEstimator and HeaveObserver FMUs
+    (module docstring); ``path`` the record (default the packaged one); ``band`` also runs a
+    HeaveObserver with ``model = "band"`` (else its fields are NaN / false)."""
+    import tempfile
+
+    from ..cosim.replay import plan_replay, run_replay
+
+    rec = rec or load_orcaflex(path)
+    acc_n, gyro_n = sensor_noise(rec)
+    with tempfile.TemporaryDirectory() as tmp:
+        mapping = Path(tmp) / "orcaflex.toml"
+        mapping.write_text(MAPPING, encoding="utf-8")
+        n = len(rec.acc)
+        # one step past the last sample, so the estimators take it too (the recording then holds)
+        step = 1.0 / RATE
+        plan = plan_replay(path or data_file(), mapping, "attitude,heave", step=step, duration=n * step)
+        from dataclasses import replace
+
+        from ..cosim.ssp import Connection
+
+        # the library's defaults and the record's noise, as in-process (not the system scenario's tuning)
+        own = {"att": {"acc_noise": acc_n, "gyro_noise": gyro_n}, "heave": {"acc_noise": acc_n}}
+        comps = tuple(replace(c, parameters=own[c.name]) if c.name in own else c for c in plan.system.components)
+        plan = replace(plan, system=replace(plan.system, components=comps))
+        heave = next(c for c in plan.system.components if c.name == "heave")
+        extra = replace(heave, name="heave_band", parameters={**heave.parameters, "model": "band"})
+        wires = tuple(Connection(c.start, c.start_var, "heave_band", c.end_var) for c in plan.system.connections
+                      if c.end == "heave")
+        system = replace(plan.system, components=plan.system.components + (extra,) * band,
+                         connections=plan.system.connections + wires * band)
+        res, _ = run_replay(replace(plan, system=system), fmu_dir, progress=False)
+    col = lambda name: np.asarray(res[name], dtype=float)  # noqa: E731
+    after = slice(1, n + 1)        # estimator outputs after sample k are in row k + 1
+    played = slice(0, n)           # the recording's sample k is in row k
+    return FmuRuns(
+        roll=col("att.roll")[after], pitch=col("att.pitch")[after],
+        heave=col("heave.heave")[after], heave_valid=np.asarray(res["heave.valid"], dtype=bool)[after],
+        heave_band=col("heave_band.heave")[after] if band else np.full(n, np.nan),
+        heave_band_valid=np.asarray(res["heave_band.valid"], dtype=bool)[after] if band else np.zeros(n, bool),
+        acc=np.column_stack([col(f"rec.imu.acc.{a}")[played] for a in "xyz"]),
+        gnss=np.column_stack([col(f"rec.gnss.ant1.{a}")[played] for a in "ned"]),
+        heading=col("rec.heading")[played],
+    )
+
+
+def heave_score(rec: OrcaflexRecord, heave: np.ndarray, valid: np.ndarray) -> dict[str, float]:
+    """Heave RMS error and true heave std [cm] of a heave run, from the sample it turns valid."""
+    kv = int(np.argmax(valid)) if valid.any() else len(valid)
+    truth_d = rec.pos[:, 2] - rec.pos[:, 2].mean()
+    return {"heave_cm": 100.0 * float(_rms(heave[kv:] - truth_d[kv:])),
+            "heave_std_cm": 100.0 * float(np.std(truth_d[kv:])), "from_s": kv * rec.dt}
+
+
+def compare_orcaflex(rec: OrcaflexRecord | None = None, fmu_dir: str | Path | None = None) -> dict[str, dict[str, float]]:
     """RMS errors on the record (module docstring): roll/pitch [deg], heave and position [cm].
+
+    Parameters
+    ----------
+    rec : OrcaflexRecord, optional
+        The record (default the packaged one).
+    fmu_dir : str or Path, optional
+        Run marinefmu's estimators through the FMUs in this folder (:func:`fmu_runs`) instead
+        of in-process.
 
     Returns
     -------
@@ -238,6 +368,8 @@ def compare_orcaflex(rec: OrcaflexRecord | None = None) -> dict[str, dict[str, f
         Run name → metric → value; ``"raw GNSS"`` scores the fixes themselves (at the fix
         samples).
     """
+    if fmu_dir is not None:
+        return _compare_fmu(rec or load_orcaflex(), fmu_dir)
     rec = rec or load_orcaflex()
     k0 = SETTLE_SAMPLES
     out: dict[str, dict[str, float]] = {}
@@ -253,6 +385,28 @@ def compare_orcaflex(rec: OrcaflexRecord | None = None) -> dict[str, dict[str, f
     fix[:k0] = False
     q = tuple(f * sensor_noise(rec)[0] ** 2 for f in RECEIVER_Q_FACTORS)
     for name, pos in (("marinefmu fusion (one receiver)", receiver_fusion(f_n, rec.gnss, rec.dt, q)),
+                      ("smsfusion AidedINS", aided_ins_run(rec)), ("raw GNSS", None)):
+        e = 100.0 * (_rms(rec.gnss[fix] - rec.pos[fix]) if pos is None else _rms(pos[k0:] - rec.pos[k0:]))
+        out[name] = {f"pos_{a}_cm": float(e[i]) for i, a in enumerate("ned")}
+    return out
+
+
+def _compare_fmu(rec: OrcaflexRecord, fmu_dir: str | Path) -> dict[str, dict[str, float]]:
+    """:func:`compare_orcaflex` with marinefmu's runs through the FMUs (the peers as before)."""
+    k0 = SETTLE_SAMPLES
+    runs = fmu_runs(fmu_dir, rec)
+    out: dict[str, dict[str, float]] = {}
+    peers = {k: v for k, v in attitude_runs(rec).items() if not k.startswith("marinefmu")}
+    for name, rp in {"marinefmu AttitudeEstimator": np.c_[runs.roll, runs.pitch], **peers}.items():
+        e = np.degrees(_rms(rp[k0:] - rec.euler[k0:, :2]))
+        out[name] = {"roll_deg": float(e[0]), "pitch_deg": float(e[1])}
+    out["marinefmu HeaveObserver"] = heave_score(rec, runs.heave, runs.heave_valid)
+    out["marinefmu HeaveObserver (band)"] = heave_score(rec, runs.heave_band, runs.heave_band_valid)
+    f_n = rotate_to_ned(runs.acc, runs.roll, runs.pitch, runs.heading)
+    fix = np.arange(len(rec.acc)) % FIX_EVERY == 0
+    fix[:k0] = False
+    q = tuple(f * sensor_noise(rec)[0] ** 2 for f in RECEIVER_Q_FACTORS)
+    for name, pos in (("marinefmu fusion (one receiver)", receiver_fusion(f_n, runs.gnss, rec.dt, q)),
                       ("smsfusion AidedINS", aided_ins_run(rec)), ("raw GNSS", None)):
         e = 100.0 * (_rms(rec.gnss[fix] - rec.pos[fix]) if pos is None else _rms(pos[k0:] - rec.pos[k0:]))
         out[name] = {f"pos_{a}_cm": float(e[i]) for i, a in enumerate("ned")}

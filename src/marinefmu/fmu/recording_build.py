@@ -1,0 +1,103 @@
+"""``marinefmu build-recording``: a self-contained SensorRecording FMU with its record bundled.
+
+The FMU is the SensorRecording script (``models/SensorRecording.py``) built as every marinefmu
+FMU is (pythonfmu's ``FmuBuilder`` with the package in ``resources/``, then units and initial
+unknowns by :mod:`marinefmu.fmu.units`, the OSP model description by :mod:`marinefmu.fmu.osp`,
+and ``fmpy.validation.validate_fmu``), plus ``resources/recording/``: the record gzip-compressed
+(a CSV; a ``.gz`` or Parquet file as it is) and its sidecar as ``mapping.toml``. Its ``file`` and
+``mapping`` parameters left empty then mean those, so the FMU can be mailed to a colleague or
+dropped into libcosim without the original file. The record and its sidecar are checked (a full
+scan, :class:`~marinefmu.sea.recording.reader.Record`) before anything is built.
+"""
+from __future__ import annotations
+
+import gzip
+import importlib.util
+import shutil
+import tempfile
+import zipfile
+from pathlib import Path
+
+from ..sea.recording.mapping import load_mapping
+from ..sea.recording.player import BUNDLE_DIR, BUNDLE_MAPPING
+from ..sea.recording.reader import Record, is_parquet
+from . import osp
+from .build import BuildError, repo_root, validate
+from .units import postprocess_model_description
+
+MODEL = "SensorRecording"
+#: The package bundled into the FMU's resources (as every marinefmu FMU bundles it).
+PACKAGE_DIR = Path(__file__).resolve().parents[1]
+
+
+def _script() -> Path:
+    return repo_root() / "models" / f"{MODEL}.py"
+
+
+def _units(script: Path) -> dict[str, str]:
+    """The slave's unit table (its ``__init__`` is cheap)."""
+    spec = importlib.util.spec_from_file_location(f"_marinefmu_recording_build_{MODEL}", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return getattr(module, MODEL)(instance_name="build", resources=str(script.parent)).io.units
+
+
+def _bundle(record: Path, mapping: Path, folder: Path) -> Path:
+    """``folder/recording/`` with the compressed record and ``mapping.toml``."""
+    dest = folder / BUNDLE_DIR
+    dest.mkdir(parents=True)
+    with open(record, "rb") as fh:
+        gz = fh.read(2) == b"\x1f\x8b"
+    if gz or is_parquet(record):
+        shutil.copyfile(record, dest / record.name)
+    else:
+        with open(record, "rb") as src, gzip.open(dest / f"{record.name}.gz", "wb", compresslevel=9) as out:
+            shutil.copyfileobj(src, out, 1 << 20)
+    shutil.copyfile(mapping, dest / BUNDLE_MAPPING)
+    return dest
+
+
+def build_recording(record: str | Path, mapping: str | Path, output: str | Path) -> Path:
+    """Build ``output`` (``NAME.fmu``) playing ``record`` with ``mapping``; return its path.
+
+    ``NAME_OspModelDescription.xml`` is written beside it.
+
+    Raises
+    ------
+    RecordingError
+        The record or its sidecar is refused (before building).
+    BuildError
+        The FMU does not validate.
+    """
+    from pythonfmu.builder import FmuBuilder
+
+    record, mapping, output = Path(record), Path(mapping), Path(output)
+    if output.suffix != ".fmu":
+        raise BuildError(f"-o {output}: the FMU's name must end in .fmu")
+    Record(record, load_mapping(mapping))    # refuse a bad record or mapping before building
+    script = _script()
+    output.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        bundle = _bundle(record, mapping, Path(tmp) / "bundle")
+        raw = Path(FmuBuilder.build_FMU(script, dest=tmp, project_files=[PACKAGE_DIR, bundle],
+                                        canGetAndSetFMUstate=True, canSerializeFMUstate=True))
+        units = _units(script)
+        with zipfile.ZipFile(raw) as zin, zipfile.ZipFile(output, "w", zipfile.ZIP_DEFLATED) as zout:
+            for item in zin.infolist():
+                data = zin.read(item.filename)
+                if item.filename == "modelDescription.xml":
+                    data = postprocess_model_description(data, units)
+                zout.writestr(item, data)
+    with zipfile.ZipFile(output) as z:
+        md_xml = z.read("modelDescription.xml")
+        names = z.namelist()
+    if f"resources/{BUNDLE_DIR}/{BUNDLE_MAPPING}" not in names:
+        output.unlink()
+        raise BuildError(f"{output.name}: the bundled record did not reach resources/{BUNDLE_DIR}/")
+    osp_file = output.with_name(f"{output.stem}_OspModelDescription.xml")
+    osp.write(md_xml, osp_file)
+    problems = validate(output) + osp.check(md_xml, osp_file.read_bytes())
+    if problems:
+        output.unlink()
+        raise BuildError(f"{output.name} failed validation:\n  " + "\n  ".join(problems))
+    return output
