@@ -162,7 +162,8 @@ def _over_goal(summary: dict, goal: float) -> str:
 
 
 #: Parts of ``marinefmu bench``, in the order they run.
-PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "dropout_gyro", "pos_std", "system", "ahc", "campaign", "memory")
+PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "dropout_gyro", "pos_std", "system", "ahc", "campaign", "hydro",
+         "defaults", "recording", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks, Hs [m], Tp [s]; Hs 4 / Tp 12 and
@@ -291,11 +292,12 @@ def peer_comparison(duration: float = 600.0) -> dict[str, dict]:
     return result
 
 
-def orcaflex_comparison() -> dict[str, dict[str, float]]:
-    """marinefmu and smsfusion on smsfusion's OrcaFlex record (:mod:`marinefmu.bench.peer_orcaflex`)."""
+def orcaflex_comparison(fmu_dir: Path | None = None) -> dict[str, dict[str, float]]:
+    """marinefmu and smsfusion on smsfusion's OrcaFlex record (:mod:`marinefmu.bench.peer_orcaflex`;
+    marinefmu's estimators through the FMUs in ``fmu_dir`` when given)."""
     from .peer_orcaflex import compare_orcaflex
 
-    scores = compare_orcaflex()
+    scores = compare_orcaflex(fmu_dir=fmu_dir)
     print("OrcaFlex record (smsfusion's test data, 10.24 Hz, 6 min), RMS errors from sample 600:")
     for name, metrics in scores.items():
         print(f"    {name:34s} " + ", ".join(f"{k} {v:.3f}" for k, v in metrics.items()), flush=True)
@@ -345,7 +347,7 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
         elif part == "peer":
             data["peer"] = {**stamp, "seas": peer_comparison()}
         elif part == "orcaflex":
-            data["orcaflex"] = {**stamp, "scores": orcaflex_comparison()}
+            data["orcaflex"] = {**stamp, "scores": orcaflex_comparison(fmu_dir)}
         elif part == "dropout":
             from ..papers import gap_bound, paper001
 
@@ -393,6 +395,18 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             from .campaign import campaign_bench
 
             data["campaign"] = {**stamp, **campaign_bench(fmu_dir, out_dir / "campaign_runs")}
+        elif part == "hydro":  # BEM presets at full resolution, closed form against BEM (marinefmu.bench.hydro)
+            from .hydro import hydro_bench
+
+            data["hydro"] = {**stamp, **hydro_bench(out_dir)}
+        elif part == "defaults":  # each estimator at its defaults, geometry only (marinefmu.bench.defaults)
+            from .defaults import defaults_bench
+
+            data["defaults"] = {**stamp, **defaults_bench()}
+        elif part == "recording":  # a 24-hour 100 Hz record streamed (marinefmu.bench.recording)
+            from .recording import recording_bench
+
+            data["recording"] = {**stamp, **recording_bench(fmu_dir, out_dir / "recording")}
         else:
             data["memory"] = {**stamp, "steps": memory_steps, "cycles": memory_cycles, "limit_mb": 10.0,
                               "fmus": memory(fmu_dir, memory_steps, memory_cycles)}

@@ -36,6 +36,13 @@ CUTOFF = 0.04
 TILT_CUTOFF = 0.02
 
 
+#: The aiding of the reproduction: fixed zero-mean pseudo-measurements, slow (1 Hz) and loose
+#: (3 m/s, 10 m), which minimise the reconstruction's displacement error on this example, whose
+#: screening removes the slow tilt drift anyway (0.07° RMS real-time tilt with the 10°/h gyro;
+#: the estimator's auto-sized default gives sharper angles but more error in the wave band).
+AIDING = {"aid_sizing": "fixed", "vel_sigma": 3.0, "pos_sigma": 10.0, "aid_rate": 1.0}
+
+
 def simulate(duration: float, noise: bool, seed: int = 1) -> dict[str, np.ndarray]:
     """VesselMotion record: gyro, acc (N, 3), truth Euler angles (N, 3), truth COG (N, 3)."""
     values = {**SEA, "sea.seed": seed, "imu.x": LEVER_ARM[0], "imu.y": LEVER_ARM[1], "imu.z": LEVER_ARM[2]}
@@ -72,7 +79,7 @@ def run(duration: float = 1200.0, noise: bool = False, mode: int | None = None, 
     rec = simulate(duration, noise)
     truth = rec["euler"]
     mode = (1 if noise else 0) if mode is None else mode
-    params = AttitudeEstimatorParams(mode=mode, init="given" if mode == 0 else "level",
+    params = AttitudeEstimatorParams(mode=mode, init="given" if mode == 0 else "level", **AIDING,
                             init_euler=tuple(float(a) for a in truth[0]) if mode == 0 else (0.0, 0.0, float(truth[0, 2])))
     att = estimate_attitude(rec["gyro"], rec["acc"], DT, params)
     refine = mode == 1 if refine is None else refine

@@ -11,6 +11,7 @@ from marinefmu.errors import ParameterError
 from marinefmu.estimators.attitude.estimator import (
     AttitudeEstimator, AttitudeEstimatorParams, estimate_attitude, integrate_gyro, integrate_gyro_euler,
 )
+from marinefmu.papers.paper000_semisub import AIDING
 from marinefmu.frames import G, euler_to_quat, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
 from marinefmu.sea.motion_model import REAL_INDEX, VesselMotion, VesselMotionParams
 
@@ -95,13 +96,16 @@ def test_levelling_from_a_static_tilt():
 
 
 def test_drift_corrected_roll_pitch_on_the_semisub():
-    """Noise-free sensors: the aided filter keeps roll/pitch within the 0.02° goal; with the
-    default MEMS noise (10°/h gyro bias instability) it reaches 0.07° (docs/fmus/AttitudeEstimator.md)."""
+    """Noise-free sensors, so what is left is wave acceleration leaking into the tilt: the slow,
+    loose fixed aiding of the paper-000 reproduction keeps roll/pitch within 0.02°; the
+    auto-sized default, sized for a real (drifting) gyro, aids faster and leaks more, but stays
+    within the 0.035° goal of the defaults (measured 0.000 / 0.033°)."""
     gyro, acc, truth = vessel_record(600.0, noise=False)
-    r = estimate_attitude(gyro, acc, 0.01, AttitudeEstimatorParams(init_euler=(0.0, 0.0, float(truth[0, 2]))))
     s = slice(20000, None)  # after levelling and convergence
-    rms = np.degrees(np.sqrt(np.mean((np.c_[r["roll"], r["pitch"]][s] - truth[s, :2]) ** 2, axis=0)))
-    assert np.all(rms < 0.02), rms
+    for aiding, limit in ((AIDING, 0.02), ({}, 0.035)):
+        r = estimate_attitude(gyro, acc, 0.01, AttitudeEstimatorParams(init_euler=(0.0, 0.0, float(truth[0, 2])), **aiding))
+        rms = np.degrees(np.sqrt(np.mean((np.c_[r["roll"], r["pitch"]][s] - truth[s, :2]) ** 2, axis=0)))
+        assert np.all(rms < limit), (aiding, rms)
 
 
 def test_bad_samples_coast_and_invalidate_without_nan():

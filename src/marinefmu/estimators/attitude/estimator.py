@@ -32,6 +32,25 @@ A tilt error ε makes a horizontal acceleration error g·ε that integrates into
 oscillatory: each integration separates the two by a further factor ω, so the filter rejects wave accelerations far better
 than a first-order complementary filter with the same crossover, and it estimates the x/y gyro
 bias. After each update the error is injected into the nominal state (q, v, b̂) and reset.
+
+The best ``vel_sigma`` and ``pos_sigma`` depend on the motion at the IMU: a vessel at rest wants
+them tight (the gyro is then the only error, and the tighter the aid the less drift), a small
+vessel in a high sea or an IMU high above the roll centre wants them loose (0.1-2 m/s across
+the benchmark's vessels, seas and placements). With ``aid_sizing = "auto"`` (default) the
+estimator sizes them from the data as it runs (what commercial motion sensors call
+auto-tuning): the horizontal tilt-compensated acceleration, high-passed, is integrated by a
+leaky integrator (time constant :data:`LEAK_TAU`, far below any wave frequency) into the wave
+velocity, whose running RMS v_rms per axis (exponential, time constant :data:`STATS_TAU`,
+corrected for the start as Adam's moments are) sets
+
+.. math::
+    σ_v = \\max(σ_{v,min},\\; c_v\\, v_{rms}),\\qquad σ_p = r_p\\, σ_v
+
+(:data:`AID_GAIN`, :data:`POS_RATIO`, :data:`SIGMA_V_MIN`; fitted on the benchmark grid, see
+the decision record on the attitude defaults). The integrator does not see the filter's
+corrections, so the sizing does not feed back on itself. Until the statistics have filled
+(the first :data:`LEAK_TAU` seconds after levelling) ``vel_sigma`` and ``pos_sigma`` are used;
+``aid_sizing = "fixed"`` uses them throughout.
 Yaw has no aid (no heading sensor): it is the integrated (bias-free-in-x/y) gyro yaw and
 drifts with the z-gyro bias.
 
@@ -57,6 +76,17 @@ from ..samples import force_beyond_limit, rate_beyond_limit
 log = logging.getLogger(__name__)
 
 INIT_CHOICES = ("given", "level")
+AID_SIZINGS = ("auto", "fixed")
+
+#: Time constant of the running RMS that sizes the aiding [s].
+STATS_TAU = 120.0
+#: Time constant of the leaky integrator that turns acceleration into wave velocity [s]
+#: (a high-pass far below the wave band: 1/(2π·40 s) = 0.004 Hz).
+LEAK_TAU = 40.0
+#: σ_v per RMS wave velocity, σ_p per σ_v, and the least σ_v [m/s] of the auto sizing.
+AID_GAIN = 1.5
+POS_RATIO = 3.0
+SIGMA_V_MIN = 0.05
 
 
 @dataclass(frozen=True)
@@ -88,12 +118,13 @@ class AttitudeEstimatorParams:
     pos_sigma : float
         Standard deviation of the zero-horizontal-position pseudo-measurement [m], (0, 1000].
         [``pos_sigma``] Larger values aid more slowly: less wave acceleration leaks into the
-        tilt, more gyro drift stays in it. The defaults (3 m/s, 10 m) minimise the
-        displacement error of the paper-000 reconstruction on the semi-submersible example,
-        whose screening removes the slow drift anyway (tilt error 0.07° RMS there with a
-        10°/h gyro; 1 m/s and 1 m give 0.035° but more error in the wave band).
+        tilt, more gyro drift stays in it; the best values depend on the motion, so by default
+        they only start the auto sizing (``aid_sizing``).
     aid_rate : float
         Rate of the pseudo-measurement [Hz], (0, 100]. [``aid_rate``]
+    aid_sizing : str
+        ``"auto"`` (default) sizes ``vel_sigma`` and ``pos_sigma`` from the measured motion as
+        it runs (module docstring), ``"fixed"`` uses them as given. [``aid_sizing``]
     """
 
     mode: int = 1
@@ -104,9 +135,10 @@ class AttitudeEstimatorParams:
     acc_noise: float = 7e-4
     gyro_bias_sigma: float = 5e-5
     gyro_bias_tau: float = 50.0
-    vel_sigma: float = 3.0
-    pos_sigma: float = 10.0
-    aid_rate: float = 1.0
+    vel_sigma: float = 1.0
+    pos_sigma: float = 3.0
+    aid_rate: float = 10.0
+    aid_sizing: str = "auto"
 
     def __post_init__(self) -> None:
         check_int("mode", self.mode, lo=0, hi=1)
@@ -123,6 +155,7 @@ class AttitudeEstimatorParams:
         check_range("vel_sigma", self.vel_sigma, lo=0.0, hi=100.0, lo_open=True, unit="m/s")
         check_range("pos_sigma", self.pos_sigma, lo=0.0, hi=1000.0, lo_open=True, unit="m")
         check_range("aid_rate", self.aid_rate, lo=0.0, hi=100.0, lo_open=True, unit="Hz")
+        check_choice("aid_sizing", self.aid_sizing, AID_SIZINGS)
 
 
 @dataclass(frozen=True)
@@ -229,6 +262,12 @@ class AttitudeEstimator:
         self.kf.R = np.diag([p.pos_sigma ** 2] * 2 + [p.vel_sigma ** 2] * 2)
         self._q_diag = np.diag([0.0, 0.0] + [p.acc_noise ** 2] * 2 + [p.gyro_noise ** 2] * 2
                                + [2.0 * p.gyro_bias_sigma ** 2 / p.gyro_bias_tau] * 2)
+        # auto sizing: the leaky integrator and its running statistics
+        self.acc_mean: np.ndarray | None = None
+        self.leak_v = np.zeros(2)
+        self.ms_v = np.zeros(2)
+        self.stats_weight = 0.0
+        self.stats_time = 0.0
 
     # ---- step ---------------------------------------------------------------------------------
     def step(self, gyro: Any, acc: Any, dt: float) -> AttitudeResult:
@@ -287,6 +326,8 @@ class AttitudeEstimator:
         f_n = rot @ acc
         self.pos += self.vel * dt + 0.5 * f_n[:2] * dt * dt  # horizontal a_n = R f_b + g_n has no g
         self.vel += f_n[:2] * dt
+        if p.aid_sizing == "auto":
+            self._wave_statistics(f_n[:2], dt)
         fz = f_n[2]
         F = np.zeros((8, 8))
         F[0:2, 2:4] = np.eye(2)
@@ -300,6 +341,9 @@ class AttitudeEstimator:
         self.since_aid += dt
         if self.since_aid >= 1.0 / p.aid_rate - 1e-9:
             self.since_aid = 0.0
+            if p.aid_sizing == "auto" and self.stats_time >= LEAK_TAU:
+                sigma_v = np.maximum(SIGMA_V_MIN, AID_GAIN * np.sqrt(self.ms_v / self.stats_weight))
+                kf.R = np.diag(np.concatenate(((POS_RATIO * sigma_v) ** 2, sigma_v ** 2)))
             kf.update(np.concatenate((self.pos, self.vel)))
             dx = kf.x.ravel()
             self.pos -= dx[0:2]
@@ -308,6 +352,19 @@ class AttitudeEstimator:
             self.q /= math.sqrt(self.q @ self.q)
             self.bias[0:2] += dx[6:8]
             kf.x[:] = 0.0
+
+    def _wave_statistics(self, a_h: np.ndarray, dt: float) -> None:
+        """Running mean square of the wave velocity [m/s, n]: the horizontal acceleration
+        [m/s², n] less its slow mean, through a leaky integrator (:data:`LEAK_TAU`); exponential
+        mean, time constant :data:`STATS_TAU`, its weight 1 − (1 − β)^k kept to correct the start."""
+        if self.acc_mean is None:
+            self.acc_mean = a_h.copy()
+        self.acc_mean += (dt / LEAK_TAU) * (a_h - self.acc_mean)
+        self.leak_v += (a_h - self.acc_mean - self.leak_v / LEAK_TAU) * dt
+        beta = dt / STATS_TAU
+        self.ms_v += beta * (self.leak_v * self.leak_v - self.ms_v)
+        self.stats_weight += beta * (1.0 - self.stats_weight)
+        self.stats_time += dt
 
     def _result(self, valid: bool, warning: str | None) -> AttitudeResult:
         roll, pitch, yaw = quat_to_euler(self.q)
@@ -322,7 +379,10 @@ class AttitudeEstimator:
             "last_acc": None if self.last_acc is None else self.last_acc.tolist(),
             "levelling": self.levelling, "level_steps": self.level_steps, "level_sum": self.level_sum.tolist(),
             "q_rel": self.q_rel.tolist(), "since_aid": self.since_aid,
-            "kf_x": self.kf.x.tolist(), "kf_P": self.kf.P.tolist(),
+            "kf_x": self.kf.x.tolist(), "kf_P": self.kf.P.tolist(), "kf_R": self.kf.R.tolist(),
+            "acc_mean": None if self.acc_mean is None else self.acc_mean.tolist(),
+            "leak_v": self.leak_v.tolist(), "ms_v": self.ms_v.tolist(),
+            "stats_weight": self.stats_weight, "stats_time": self.stats_time,
         }
 
     def set_state(self, s: dict) -> None:
@@ -336,7 +396,10 @@ class AttitudeEstimator:
         self.levelling, self.level_steps = bool(s["levelling"]), int(s["level_steps"])
         self.level_sum, self.q_rel = np.array(s["level_sum"]), np.array(s["q_rel"])
         self.since_aid = float(s["since_aid"])
-        self.kf.x, self.kf.P = np.array(s["kf_x"]), np.array(s["kf_P"])
+        self.kf.x, self.kf.P, self.kf.R = np.array(s["kf_x"]), np.array(s["kf_P"]), np.array(s["kf_R"])
+        self.acc_mean = None if s["acc_mean"] is None else np.array(s["acc_mean"])
+        self.leak_v, self.ms_v = np.array(s["leak_v"]), np.array(s["ms_v"])
+        self.stats_weight, self.stats_time = float(s["stats_weight"]), float(s["stats_time"])
 
 
 def estimate_attitude(gyro: np.ndarray, acc: np.ndarray, dt: float, params: AttitudeEstimatorParams | None = None) -> dict[str, np.ndarray]:
