@@ -1,5 +1,5 @@
 """DisplacementReconstructor FMU: COG displacement from acceleration without integration
-(paper 000) on a sliding window. Thin adapter over
+(paper 000) on a sliding window, at its centre (``delay`` s late). Thin adapter over
 ``marinefmu.estimators.reconstruction.sliding``; never raises (see ``marinefmu.fmu.slave``)."""
 from pythonfmu import Fmi2Slave
 
@@ -44,7 +44,7 @@ else:
             i = self.io.inputs
             r = self.model.step((i["acc.x"], i["acc.y"], i["acc.z"]), (i["roll"], i["pitch"], i["yaw"]), dt)
             self.io.warn(r.warning, t, r.valid)
-            self.io.set_outputs([*r.disp, *r.vel, *r.centred_disp, *r.centred_vel, r.delay, r.latency], [r.valid])
+            self.io.set_outputs([*r.disp, *r.vel, r.delay], [r.valid])
 
         def _get_fmu_state(self):
             return self.io.get_state(self.model)

@@ -53,13 +53,13 @@ def test_reconstructor_fmu_equals_in_process(fmu_dir, tmp_path, record):
     f = Driver(fmu_dir / "DisplacementReconstructor.fmu", tmp_path, "rec")
     f.init(params)
     est = DisplacementReconstructor(sliding_params(params))
-    outs = ["disp.n", "disp.e", "disp.d", "centred.disp.n", "centred.disp.e", "centred.disp.d", "latency"]
+    outs = ["disp.n", "disp.e", "disp.d", "vel.n", "vel.e", "vel.d", "delay"]
     for k in range(7600):
         a, e = record["acc"][k], record["euler"][k]
         inputs = {"acc.x": a[0], "acc.y": a[1], "acc.z": a[2], "roll": e[0], "pitch": e[1], "yaw": e[2]}
         status, reals, valid = f.step(k, inputs, outs)
         r = est.step(a, e, DT)
-        assert status in (0, None) and reals == [*r.disp, *r.centred_disp, r.latency] and valid == [r.valid]
+        assert status in (0, None) and reals == [*r.disp, *r.vel, r.delay] and valid == [r.valid]
     assert valid == [True]
     f.close()
 

@@ -49,8 +49,9 @@ LABELS = {
     "point_heave_cm": "heave at the point, RMS error [cm]", "point_heave_std_cm": "true heave std at the point [cm]",
     "cr_x_m": "centre of rotation x, RMS error [m]", "cr_y_m": "centre of rotation y, RMS error [m]",
     "cr_z_m": "centre of rotation z, RMS error [m]",
-    "disp_n_cm": "COG north, centred estimate, RMS error [cm]", "disp_e_cm": "COG east, centred estimate, RMS error [cm]",
-    "disp_d_cm": "COG down, centred estimate, RMS error [cm]",
+    "disp_n_cm": "COG north (window centre, delay s late), RMS error [cm]",
+    "disp_e_cm": "COG east (window centre, delay s late), RMS error [cm]",
+    "disp_d_cm": "COG down (window centre, delay s late), RMS error [cm]",
     "valid_fraction": "fraction of the run with valid output", "scored_s": "time scored [s]",
     "tip_heave_cm": "crane-tip heave std [cm]", "load_heave_cm": "load heave std [cm]",
     "residual_pct": "load heave / tip heave [%]", "tip_motion_cm": "crane-tip vertical motion std, all frequencies [cm]",
@@ -188,8 +189,8 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
             ax.set_xlabel("time [s]")
             ax.legend(loc="upper right", ncol=3, fontsize=8)
             out.append((f"{c}: convergence of the centre of rotation (settled running mean)", _png(fig)))
-        elif kind == "DisplacementReconstructor" and f"{c}.centred.disp.d" in fields:
-            delay = float(g(f"{c}.centred.delay")[-1])
+        elif kind == "DisplacementReconstructor" and f"{c}.disp.d" in fields and f"{c}.delay" in fields:
+            delay = float(g(f"{c}.delay")[-1])
             lag = int(round(delay / (t[1] - t[0])))
             valid = np.asarray(result[f"{c}.valid"], dtype=bool)
             window = last & valid
@@ -198,14 +199,14 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
                 k = np.flatnonzero(window)
                 k = k[k >= lag]
                 for a, col in (("n", "tab:blue"), ("e", "tab:orange"), ("d", "tab:green")):
-                    truth, est = g(f"{v}.truth.cog.{a}")[k - lag], g(f"{c}.centred.disp.{a}")[k]
+                    truth, est = g(f"{v}.truth.cog.{a}")[k - lag], g(f"{c}.disp.{a}")[k]
                     ax.plot(t[k - lag], truth - truth.mean(), color=col, lw=2, alpha=0.4, label=f"true COG {a}")
                     ax.plot(t[k - lag], est - est.mean(), color=col, lw=0.9, label=f"reconstructed {a}")
                 ax.set_ylabel("displacement about the mean [m, NED]")
                 ax.set_xlabel(f"time [s] (the estimate is available {delay:g} s later)")
                 ax.legend(loc="upper right", ncol=3, fontsize=8)
-                out.append((f"{c}: COG displacement reconstructed from acceleration alone (no GNSS), centred "
-                            f"window estimate, {delay:g} s behind real time", _png(fig)))
+                out.append((f"{c}: COG displacement reconstructed from acceleration alone (no GNSS), at the "
+                            f"window centre, {delay:g} s behind real time", _png(fig)))
     winches = [c.name for c in system.components if c.kind == "AhcWinch" and f"{c.name}.load.d" in fields]
     tip = f"{vessel}.truth.point.d"
     if winches and tip in fields:

@@ -2,17 +2,17 @@
 
 Where the record holds a reference signal (``rec.ref.*``), each estimate is scored against it:
 
-==========================  ===================================  ==========
-estimate                     reference                            about mean
-==========================  ===================================  ==========
-``att.roll``, ``att.pitch``  ``ref.roll``, ``ref.pitch``           no
-``heave.heave``              ``ref.heave`` (at the IMU, down)      yes
-``heave.point.heave``        ``ref.point.d``                       yes
-``fusion.pos.{n,e,d}``       ``ref.cog.{n,e,d}``                   no
-``recon.disp.*``             ``ref.cog.*``                         yes
-==========================  ===================================  ==========
+================================  =====================================  ==========
+estimate                          reference                              about mean
+================================  =====================================  ==========
+``att.roll``, ``att.pitch``       ``ref.roll``, ``ref.pitch``            no
+``heave.heave``                   ``ref.heave`` (at the IMU, down)       yes
+``heave.point.heave``             ``ref.point.d``                        yes
+``fusion.pos.{n,e,d}``            ``ref.cog.{n,e,d}``                    no
+``recon.disp.*``                  ``ref.cog.*``                          yes
+================================  =====================================  ==========
 
-(a reconstructor with ``centred.disp.*`` outputs is scored on those too) on the steps where the
+(``recon.disp.*`` are the window-centre estimate, ``recon.delay`` s late) on the steps where the
 estimator's ``valid`` and the reference's ``valid`` are both true, from
 ``settle`` s after the estimator first turned valid. A recorded reference and an estimate made
 from the same record can be offset in time (the co-simulation's one-step coupling, a sensor's
@@ -42,8 +42,8 @@ PAIRS: tuple[tuple[str, str, str, bool, str, str, float], ...] = (
     ("heave.heave", "ref.heave", "ref.heave.valid", True, "heave at the IMU", "cm", 100.0),
     ("heave.point.heave", "ref.point.d", "ref.point.valid", True, "heave at the point", "cm", 100.0),
     *((f"fusion.pos.{a}", f"ref.cog.{a}", "ref.cog.valid", False, f"COG position {a}", "cm", 100.0) for a in "ned"),
-    *((f"recon.{o}.{a}", f"ref.cog.{a}", "ref.cog.valid", True, f"COG displacement {a}", "cm", 100.0)
-      for o in ("disp", "centred.disp") for a in "ned"),   # the reconstructor's outputs, whichever it has
+    *((f"recon.disp.{a}", f"ref.cog.{a}", "ref.cog.valid", True, f"COG displacement {a}", "cm", 100.0)
+      for a in "ned"),
 )
 
 
@@ -198,8 +198,8 @@ def _figures(result: np.ndarray, plan: ReplayPlan, scores: dict[str, dict], plt)
     return figs
 
 
-_SHOWN = {"roll", "pitch", "yaw", "heave", "point.heave", "pos.n", "pos.e", "pos.d", "centred.disp.n",
-          "centred.disp.e", "centred.disp.d", "cr.x", "cr.y", "cr.z"}
+_SHOWN = {"roll", "pitch", "yaw", "heave", "point.heave", "pos.n", "pos.e", "pos.d", "disp.n",
+          "disp.e", "disp.d", "cr.x", "cr.y", "cr.z"}
 
 
 def _mapped_flag(plan: ReplayPlan, name: str) -> bool:

@@ -13,8 +13,8 @@ GnssAccFusion               ``pos_n_cm``, ``pos_e_cm``, ``pos_d_cm`` (truth.cog)
 HeaveObserver               ``heave_cm`` (truth.imu.d), ``point_heave_cm`` (truth.point.d), each
                             about its mean over the scored span as the observer has no mean;
                             ``heave_std_cm``, ``point_heave_std_cm`` of the truth for scale
-DisplacementReconstructor   ``disp_n_cm``, ``disp_e_cm``, ``disp_d_cm``: the centred (delayed)
-                            estimate against truth.cog ``centred.delay`` s earlier, each about its
+DisplacementReconstructor   ``disp_n_cm``, ``disp_e_cm``, ``disp_d_cm``: its output (the window
+                            centre) against truth.cog ``delay`` s earlier, each about its
                             mean (a reconstruction from acceleration has no absolute position)
 CentreOfRotation            ``cr_x_m``, ``cr_y_m``, ``cr_z_m`` (truth.cr, when the vessel runs in
                             the independent-rotation-centre mode and ``truth.cr.defined``)
@@ -169,13 +169,13 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
                 point = f(f"{v}.truth.point.d")[m]
                 row["point_heave_cm"] = 100.0 * _rms(f(f"{c}.point.heave")[m] - _about_mean(point))
                 row["point_heave_std_cm"] = 100.0 * float(np.std(point)) if point.size else math.nan
-        elif kind == "DisplacementReconstructor" and has(f"{c}.centred.disp.d", f"{c}.centred.delay", f"{v}.truth.cog.d"):
-            lag = int(round(float(f(f"{c}.centred.delay")[-1]) / (t[1] - t[0]))) if len(t) > 1 else 0
+        elif kind == "DisplacementReconstructor" and has(f"{c}.disp.d", f"{c}.delay", f"{v}.truth.cog.d"):
+            lag = int(round(float(f(f"{c}.delay")[-1]) / (t[1] - t[0]))) if len(t) > 1 else 0
             k = np.flatnonzero(m)
             k = k[k >= lag]
             for a in "ned":
                 truth = f(f"{v}.truth.cog.{a}")[k - lag]
-                est = f(f"{c}.centred.disp.{a}")[k]
+                est = f(f"{c}.disp.{a}")[k]
                 row[f"disp_{a}_cm"] = 100.0 * _rms(_about_mean(est) - _about_mean(truth))
         elif (kind == "CentreOfRotation" and has(f"{c}.cr.x", f"{v}.truth.cr.x", f"{v}.truth.cr.defined")
               and np.asarray(result[f"{v}.truth.cr.defined"], dtype=bool).any()):

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..estimators.attitude.estimator import INIT_CHOICES, AttitudeEstimatorParams
+from ..estimators.attitude.estimator import AID_SIZINGS, INIT_CHOICES, AttitudeEstimatorParams
 from ..estimators.centre_of_rotation.filter import ANGLE_CHOICES as CR_ANGLE_CHOICES
 from ..estimators.centre_of_rotation.filter import CentreOfRotationParams
 from ..estimators.heave.band_bank import BAND_VARIANCES
@@ -39,8 +39,9 @@ ATTITUDE_PARAMETERS: list[Variable] = [
     real("acc_noise", _ATT.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 10]"),
     real("gyro_bias_sigma", _ATT.gyro_bias_sigma, "rad/s", "Gyro bias standard deviation, (0, 1]"),
     real("gyro_bias_tau", _ATT.gyro_bias_tau, "s", "Gyro bias correlation time, 1..1e6"),
-    real("vel_sigma", _ATT.vel_sigma, "m/s", "Zero-velocity pseudo-measurement standard deviation, (0, 100]"),
-    real("pos_sigma", _ATT.pos_sigma, "m", "Zero-position pseudo-measurement standard deviation, (0, 1000]"),
+    Variable("aid_sizing", "string", _ATT.aid_sizing, "", f"Aiding size: one of {', '.join(AID_SIZINGS)} (auto: vel_sigma and pos_sigma sized from the measured motion; fixed: as given)"),
+    real("vel_sigma", _ATT.vel_sigma, "m/s", "Zero-velocity pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 100]"),
+    real("pos_sigma", _ATT.pos_sigma, "m", "Zero-position pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 1000]"),
     real("aid_rate", _ATT.aid_rate, "Hz", "Pseudo-measurement rate, (0, 100]"),
 ]
 ATTITUDE_INPUTS: list[Variable] = [
@@ -77,12 +78,9 @@ RECONSTRUCTOR_INPUTS: list[Variable] = [
     real("yaw", 0.0, "rad", "Yaw (ZYX Euler)"),
 ]
 RECONSTRUCTOR_OUTPUTS: list[Variable] = [
-    *vec("disp", "ned", 0.0, "m", "COG displacement at the latest sample (window model extrapolated by latency), NED"),
-    *vec("vel", "ned", 0.0, "m/s", "COG velocity at the latest sample, NED"),
-    *vec("centred.disp", "ned", 0.0, "m", "COG displacement at time - centred.delay (window centre), NED"),
-    *vec("centred.vel", "ned", 0.0, "m/s", "COG velocity at time - centred.delay, NED"),
-    real("centred.delay", 0.5 * _SL.window, "s", "Delay of the centred estimate (window / 2)"),
-    real("latency", 0.0, "s", "Time from the end of the fitted window to the latest sample"),
+    *vec("disp", "ned", 0.0, "m", "COG displacement at time - delay (the window centre), NED"),
+    *vec("vel", "ned", 0.0, "m/s", "COG velocity at time - delay, NED"),
+    real("delay", 0.5 * _SL.window, "s", "How late disp and vel are: window / 2"),
 ]
 RECONSTRUCTOR_BOOLEANS: list[Variable] = [
     Variable("valid", "boolean", False, "", "False until the first window is full, on a rejected sample, and while >1 % of the fitted window was replaced"),
@@ -96,7 +94,7 @@ def attitude_params(values: dict[str, Any]) -> AttitudeEstimatorParams:
         mode=v["mode"], init=v["init"], init_euler=(v["init.roll"], v["init.pitch"], v["init.yaw"]),
         level_time=v["level_time"], gyro_noise=v["gyro_noise"], acc_noise=v["acc_noise"],
         gyro_bias_sigma=v["gyro_bias_sigma"], gyro_bias_tau=v["gyro_bias_tau"], vel_sigma=v["vel_sigma"],
-        pos_sigma=v["pos_sigma"], aid_rate=v["aid_rate"],
+        pos_sigma=v["pos_sigma"], aid_rate=v["aid_rate"], aid_sizing=v["aid_sizing"],
     )
 
 
@@ -379,3 +377,25 @@ CONTROLLER_BOOLEANS: list[Variable] = [
 def controller_params(values: dict[str, Any]) -> AhcControllerParams:
     """AhcControllerParams from FMI-named values."""
     return AhcControllerParams(**resolve(CONTROLLER_PARAMETERS, values, "AhcController"))   # FMI names = field names
+
+
+# --- SensorRecording: a recorded file played back with VesselMotion's sensor names ---
+# Its outputs are the record schema of marinefmu.sea.recording.schema (fixed at build time: a
+# signal the record lacks comes out as zeros with its valid flag false), re-exported here.
+
+from ..sea.recording.schema import BOOLEAN_OUTPUTS as SENSOR_RECORDING_BOOLEANS  # noqa: E402,F401
+from ..sea.recording.schema import REAL_OUTPUTS as SENSOR_RECORDING_OUTPUTS  # noqa: E402,F401
+
+SENSOR_RECORDING_PARAMETERS: list[Variable] = [
+    Variable("file", "string", "", "", "Recorded file: CSV, CSV.gz or Parquet (relative paths: to the working folder, else to the mapping's folder); empty in a bundled FMU = its resources/recording/ record"),
+    Variable("mapping", "string", "", "", "Mapping sidecar (TOML): time column and unit, a column per signal with scale and offset, units, frames, lever arms; empty in a bundled FMU = its resources/recording/ sidecar"),
+    real("start", 0.0, "s", "Offset into the record played at the start time (record time 0 = first sample), [0, record length)"),
+]
+
+
+def sensor_recording_params(values: dict[str, Any]):
+    """SensorRecordingParams from FMI-named values."""
+    from ..sea.recording.player import SensorRecordingParams
+
+    v = resolve(SENSOR_RECORDING_PARAMETERS, values, "SensorRecording")
+    return SensorRecordingParams(file=v["file"], mapping=v["mapping"], start=v["start"])

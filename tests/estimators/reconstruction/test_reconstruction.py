@@ -142,11 +142,17 @@ def sliding_record(seconds=330.0):
 def test_sliding_window_centred_estimate_and_validity():
     acc, euler, cog = sliding_record()
     sr = DisplacementReconstructor(DisplacementReconstructorParams(window=200.0, hop=20.0, lever_arm=paper000_semisub.LEVER_ARM))
+    assert sr.estimate_at(0.0) is None  # nothing fitted yet
     out = [sr.step(acc[k], euler[k], 0.01) for k in range(len(acc))]
     first = next(k for k, r in enumerate(out) if r.valid)
     assert first == 19999  # the sample at t = 200 s fills the window
-    assert out[-1].delay == 100.0 and 0.0 <= out[-1].latency < 20.0
-    centred = np.array([r.centred_disp for r in out[20000:]])
+    assert out[-1].delay == 100.0
+    # the output is the model at the window centre, delay s before the latest sample
+    d, v = sr.estimate_at(out[-1].delay)
+    assert tuple(d) == out[-1].disp and tuple(v) == out[-1].vel
+    with pytest.raises(ValueError, match="lag must be in"):
+        sr.estimate_at(200.0)
+    centred = np.array([r.disp for r in out[20000:]])
     truth = cog[20000 - 10000:len(cog) - 10000]
     err = centred - (truth - truth.mean(axis=0))
     rel = np.sqrt(np.mean(err ** 2, axis=0)) / truth.std(axis=0)
@@ -162,7 +168,7 @@ def test_sliding_bad_samples_hold_invalidate_and_state_round_trips():
     for k in range(7500):
         sr.step(acc[k], euler[k], 0.01)
     r = sr.step([np.nan, 0.0, 0.0], euler[7500], 0.01)
-    assert not r.valid and r.warning and all(map(math.isfinite, r.disp + r.centred_disp))
+    assert not r.valid and r.warning and all(map(math.isfinite, r.disp + r.vel))
     saved = json.loads(json.dumps(sr.get_state()))
     a = [sr.step(acc[k], euler[k], 0.01) for k in range(7501, 9100)]
     sr2 = DisplacementReconstructor(p)

@@ -3,12 +3,17 @@
 Every ``hop`` seconds, once ``window`` seconds of samples are in, the tilt-corrected
 acceleration of the last window is decomposed (:func:`~.decomposition.decompose`, one call per
 axis), screened, and kept as a continuous-time model. Between refits each step evaluates that
-model:
+model at the window's centre, t − ``delay`` with ``delay`` = window/2, where the fit has data on
+both sides and is best: that is the estimate (``disp``, ``vel``).
 
-- the **latest** estimate at the current time t (the model extrapolated at most ``hop``
-  seconds past the end of its window: ``latency`` says how far);
-- the **centred** estimate at t − window/2 (inside the window, where the fit is best), with
-  that fixed ``delay``.
+There is no estimate of the present. The window's model evaluated past the end of its window
+(at the current time, up to ``hop`` s past it) has no predictive skill: its components are a
+fit of a random sea inside the window, not the sea's own modes, and a pair of growing and
+decaying components that cancel inside the window diverges outside it. Dropping the growing
+components, or continuing every component undamped, does no better; the measured errors are
+on the FMU's page and ``marinefmu.bench.reconstruction_outputs`` reproduces them.
+:meth:`DisplacementReconstructor.estimate_at` evaluates the model at any lag inside the window
+(and at lag 0, the extrapolation) for such measurements.
 
 The COG transfer (eq. 32) subtracts R_nb(t) l minus its straight-line trend over the window,
 the online counterpart of :func:`~.decomposition.lever_arm_offset`'s high-pass.
@@ -88,16 +93,13 @@ class DisplacementReconstructorParams:
 
 @dataclass(frozen=True)
 class DisplacementReconstructorResult:
-    """One step's output: COG displacement/velocity [m, m/s, NED] at the current time and at
-    t − delay, ``delay`` [s], ``latency`` [s] (time past the end of the fitted window),
-    ``valid`` and the rejection ``warning``, if any."""
+    """One step's output: the COG displacement ``disp`` [m, NED] and velocity ``vel`` [m/s, NED]
+    at t − ``delay``, the window's centre; ``delay`` [s] (window / 2); ``valid`` and the
+    rejection ``warning``, if any."""
 
     disp: tuple[float, float, float]
     vel: tuple[float, float, float]
-    centred_disp: tuple[float, float, float]
-    centred_vel: tuple[float, float, float]
     delay: float
-    latency: float
     valid: bool
     warning: str | None = None
 
@@ -145,7 +147,7 @@ class DisplacementReconstructor:
 
     # ---- per step ------------------------------------------------------------------------------
     def step(self, acc, euler, dt: float) -> DisplacementReconstructorResult:
-        """Add one sample and return the estimates.
+        """Add one sample and return the estimate at the window centre.
 
         Parameters
         ----------
@@ -178,7 +180,7 @@ class DisplacementReconstructor:
         self.k += 1
         if self.k >= self.n_win and (self.k - self.n_win) % self.n_hop == 0:
             self._refit()
-        return self._outputs(arm, warning)
+        return self._outputs(warning)
 
     def _ordered(self, buf: np.ndarray) -> np.ndarray:
         i = self.k % self.n_win
@@ -211,24 +213,34 @@ class DisplacementReconstructor:
                 vel[axis] = (e @ c1).real
         return disp, vel
 
-    def _outputs(self, arm_now: np.ndarray, warning: str | None) -> DisplacementReconstructorResult:
-        p, dt = self.params, self.dt
-        delay = 0.5 * p.window
-        if self.models is None:
-            z = (0.0, 0.0, 0.0)
-            return DisplacementReconstructorResult(z, z, z, z, delay, 0.0, False, warning)
-        t_now = (self.k - 1) * dt - self.t_start  # time of the latest sample from the window start
-        latency = t_now - (self.n_win - 1) * dt
-        d_now, v_now = self._eval(t_now)
-        t_c = t_now - delay
-        d_c, v_c = self._eval(t_c)
-        k_c = int(round(self.t_start / dt)) + int(round(t_c / dt))  # absolute index of the centred sample
-        arm_c = self.arm[k_c % self.n_win]
+    def estimate_at(self, lag: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The current window model's COG displacement [m, NED] and velocity [m/s, NED] at
+        ``lag`` s before the latest sample, or None before the first fit.
+
+        ``lag`` = ``delay`` is the output of :meth:`step`; ``lag`` = 0 the model extrapolated to
+        the present, up to ``hop`` s past the end of its window, which errs more than the motion
+        itself (module docstring). ``lag`` is rounded to a sample, 0 ≤ ``lag`` < ``window``.
+        """
+        if self.dt is None or self.models is None:
+            return None
+        dt = self.dt
+        j = int(round(lag / dt))
+        if not 0 <= j < self.n_win:
+            raise ValueError(f"lag must be in [0, window) = [0, {self.params.window:g}) s, got {lag!r}")
+        k = self.k - 1 - j  # absolute index of the sample
+        t_rel = k * dt - self.t_start  # its time from the start of the fitted window
+        disp, vel = self._eval(t_rel)
         off, slope = self.trend
-        d_now = d_now - (arm_now - (off + slope * t_now))
-        d_c = d_c - (arm_c - (off + slope * t_c))
-        valid = warning is None and self.fit_bad_fraction <= p.max_bad_fraction
-        return DisplacementReconstructorResult(tuple(d_now), tuple(v_now), tuple(d_c), tuple(v_c), delay, latency, valid, warning)
+        return disp - (self.arm[k % self.n_win] - (off + slope * t_rel)), vel
+
+    def _outputs(self, warning: str | None) -> DisplacementReconstructorResult:
+        delay = 0.5 * self.params.window
+        est = self.estimate_at(delay)
+        if est is None:
+            z = (0.0, 0.0, 0.0)
+            return DisplacementReconstructorResult(z, z, delay, False, warning)
+        valid = warning is None and self.fit_bad_fraction <= self.params.max_bad_fraction
+        return DisplacementReconstructorResult(tuple(est[0]), tuple(est[1]), delay, valid, warning)
 
     # ---- FMU state ---------------------------------------------------------------------------
     def get_state(self) -> dict:
