@@ -20,9 +20,11 @@ demo: fmus
 	$(VENV)/bin/marinefmu simulate system --out results/system
 
 # Two test workers (pytest-xdist), one per core of the CI machine; a file's tests stay together so
-# its module fixtures (the conformance runs, the long co-simulations) are built once.
+# its module fixtures (the conformance runs, the long co-simulations) are built once. The files go
+# out in collection order, the long ones first (tests/conftest.py, LONG_FIRST), not xdist's
+# most-tests-first, which leaves the few-test long files to the end on one worker.
 test: fmus
-	$(PY) -m pytest -q -n 2 --dist loadfile --durations=20
+	$(PY) -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder --durations=20
 
 bench: fmus
 	$(VENV)/bin/marinefmu bench --out bench

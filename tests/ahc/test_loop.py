@@ -97,29 +97,38 @@ def test_a_loop_with_a_missing_piece_is_refused_by_name():
     assert {c.name for c in subsystem(system, {"vessel", "att", "heave"}).components} == {"vessel", "att", "heave"}
 
 
+#: The four-way run of the test: the scenario's 418 s start-up and 10 of its 31 scored minutes
+#: (the bench's part ahc runs all 38 minutes and reports the residuals and limit times).
+FOUR_WAYS_S = 1020.0
+
+
 @pytest.mark.fmu
 def test_four_ways_to_drive_the_winch_against_the_goals(fmu_dir):
-    """The built-in scenario ``ahc``, 38 min (31 scored) at Hs 3 m, Tp 9 s, FMPy runner.
-    Measured: the load's heave (periods < 31 s) is 100.5 % of the tip's with no compensation,
-    1.02 % fed the truth, 4.89 % fed the classical filter (at its best cutoff), 0.95 % fed our
-    observer (0.96 % with window_max 600 s); over all frequencies the observer-fed load moves
-    2.43 % (the AttitudeEstimator's slow 0.03° error times the 45 m lever arm; truth-fed 1.02 %).
-    The linear model of the design predicts the two loops from this run's identified observer to
-    15 % (predicted 1.00 % and 1.03 %)."""
+    """The built-in scenario ``ahc`` at Hs 3 m, Tp 9 s under the FMPy runner, its first 17 min
+    (10 scored). Measured: the load's heave (periods < 31 s) is 100.5 % of the tip's with no
+    compensation, 1.03 % fed the truth, 4.50 % fed the classical filter (at its best cutoff),
+    1.28 % fed our observer; over all frequencies the observer-fed load moves 2.11 % (the
+    AttitudeEstimator's slow error times the 45 m lever arm). The linear model of the design
+    predicts the two loops from this run's identified observer to 15 % (predicted 1.27 % and
+    1.03 %). Over the whole 38 min (31 scored): 100.5, 1.02, 4.63, 1.15 and 1.97 %, predicted
+    1.16 and 1.03 %. The first 10 scored minutes are harder on the observer (its spectrum window
+    still growing: 1.24 × the ideal against 1.12 over 31 min; 1.23 and 1.15 with sea and sensor
+    seed 2), so each goal below holds with room over the shorter run too: the nearest, the
+    observer at ≤ 1.5 × the ideal, by 17 %."""
     from marinefmu.cosim.system import SystemRunner
     from marinefmu.analysis.scoring import score
 
     sc = load_scenario("ahc")
-    r = SystemRunner(sc.system, fmu_dir).run(sc.duration, record=sc.record, progress=False)
+    r = SystemRunner(sc.system, fmu_dir).run(FOUR_WAYS_S, record=sc.record, progress=False)
     s = score(r, sc.system, "vessel")
     none, ideal, classic, obs = (s[f"winch_{n}"] for n in ("none", "ideal", "classic", "observer"))
-    assert obs["scored_s"] >= 1800.0
+    assert obs["scored_s"] >= 600.0
     assert 99.0 < none["residual_pct"] < 102.0                        # the wire alone: the load follows the tip
     assert obs["residual_pct"] <= 5.0                                 # goal: ≤ 5 % of the tip's heave
     assert obs["vs_ideal"] <= 1.5 and obs["vs_ideal"] == obs["residual_pct"] / ideal["residual_pct"]   # goal
     assert obs["vs_classical"] < 1.0 and classic["residual_pct"] > 2 * obs["residual_pct"]            # goal
     assert all(w["limited_pct"] <= 1.0 for w in (ideal, classic, obs))                                # goal
-    assert obs["residual_total_pct"] <= 5.0                           # all frequencies too (measured 2.43 %)
+    assert obs["residual_total_pct"] <= 5.0                           # all frequencies too (measured 2.11 %)
 
     # the design's model against this run: predicted from the identified observer, both loops
     m = r["time"] >= 420.0

@@ -298,27 +298,47 @@ def _errors(record, out, obs, settle=120.0):
             float(np.std(ti)), float(np.std(tp)))
 
 
-@pytest.mark.parametrize("hs,tp,model", [
-    # measured (bench part heave, window_max 1200 s) IMU / point / delayed [cm]
-    (1.0, 6.0, "band"),    # 0.26 / 0.27 / 0.12 (goals 2 / 2 / 1)
-    (1.0, 6.0, "wiener"),  # 0.22 / 0.22 / 0.09
-    (2.5, 9.0, "band"),    # 1.03 / 1.03 / 0.43 (goals 2 / 2 / 1)
-    (2.5, 9.0, "wiener"),  # 0.88 / 0.88 / 0.24
-    (4.0, 12.0, "wiener"),  # 2.08 / 2.39 / 0.86 (goals 2.10 / 2.75 / 1; 2.11 with window_max 600; band 2.30: not met)
-    (1.0, 14.0, "band"),   # 1.58 / 1.58 / 0.70 (goals 2 / 2 / 1; 1.98 with band_min 0.25)
-    (1.0, 14.0, "wiener"),  # 1.54 / 1.54 / 0.53
-    pytest.param(4.0, 14.0, "band", marks=pytest.mark.xfail(strict=True, reason=(
-        "goal not met: measured 2.94 / 2.98 / 1.53 cm against 2.28 / 2.72 / 1.0; no causal estimator on this "
-        "IMU does better than about 2.4 cm at the IMU (paper003.causal_bound; docs/fmus/HeaveObserver.md)"))),
-    pytest.param(4.0, 14.0, "wiener", marks=pytest.mark.xfail(strict=True, reason=(
-        "goal not met: measured 2.69 / 2.76 / 1.19 cm against 2.28 / 2.72 / 1.0 (the causal bound: about 2.4 cm)"))),
+def _head(rec, seconds):
+    """The first ``seconds`` of a record: exactly the shorter record (VesselMotion steps in order)."""
+    n = int(round(seconds / DT))
+    return {k: v[:n] for k, v in rec.items()}
+
+
+#: 2 min + 10 min scored: a 10-min record's errors are within 10 % of the 30-min ones (seed 3,
+#: every sea below), and each sea that meets the goal over 30 min meets it over 10 min with 16 %
+#: to spare or more, but for 4 / 12 (run over 30 min). The bench part heave runs the 30-min
+#: checks of every sea and reports the goals met or not.
+SHORT = 720.0
+
+
+@pytest.mark.parametrize("hs,tp,model,duration", [
+    # measured IMU / point / delayed [cm] over the record run (in brackets over 30 min after 2:
+    # bench part heave, window_max 1200 s); the goals follow each record's heave std (4 / 14:
+    # 2.14 / 2.58 cm over 12 min, 2.28 / 2.72 over 32)
+    (1.0, 6.0, "band", SHORT),     # 0.26 / 0.26 / 0.12 (0.26 / 0.27 / 0.12; goals 2 / 2 / 1)
+    (1.0, 6.0, "wiener", SHORT),   # 0.23 / 0.23 / 0.09 (0.22 / 0.22 / 0.09)
+    (2.5, 9.0, "band", SHORT),     # 1.02 / 1.02 / 0.44 (1.03 / 1.03 / 0.43; goals 2 / 2 / 1)
+    (2.5, 9.0, "wiener", SHORT),   # 0.91 / 0.91 / 0.26 (0.88 / 0.88 / 0.24)
+    # at the goal's edge, so over the full 30 min: over 12 min the IMU error is 2.24 cm against
+    # 2 cm (the spectrum window still growing); the Wiener filter runs it in ~20 s
+    (4.0, 12.0, "wiener", 1920.0),  # 2.08 / 2.39 / 0.86 (goals 2.10 / 2.75 / 1; 2.11 with window_max 600; band 2.30: not met)
+    (1.0, 14.0, "band", SHORT),    # 1.57 / 1.57 / 0.73 (1.58 / 1.58 / 0.70; goals 2 / 2 / 1; 1.98 with band_min 0.25)
+    (1.0, 14.0, "wiener", SHORT),  # 1.67 / 1.67 / 0.60 (1.54 / 1.54 / 0.53)
+    pytest.param(4.0, 14.0, "band", SHORT, marks=pytest.mark.xfail(strict=True, reason=(
+        "goal not met: measured 2.86 / 2.85 / 1.55 cm over 12 min (2.94 / 2.98 / 1.53 over 32) against "
+        "2.14 / 2.58 / 1.0; no causal estimator on this IMU does better than about 2.4 cm at the IMU "
+        "(paper003.causal_bound; docs/fmus/HeaveObserver.md)"))),
+    pytest.param(4.0, 14.0, "wiener", SHORT, marks=pytest.mark.xfail(strict=True, reason=(
+        "goal not met: measured 2.91 / 2.95 / 1.32 cm over 12 min (2.69 / 2.76 / 1.19 over 32) against "
+        "2.14 / 2.58 / 1.0 (the causal bound: about 2.4 cm)"))),
 ])
-def test_heave_accuracy_meets_the_goal(hs, tp, model, record):
-    """VesselMotion JONSWAP sea, default MEMS noise, 30 min after 2 min: real-time heave at the
-    IMU and at a bow point 40 m away within max(2 cm, 2.5 % of the heave std), delayed heave
-    within max(1 cm, 1 %) (the project's goals, beyond the 5 cm / 5 % of commercial MRUs); the
-    band observer and the Wiener filter (model = "wiener")."""
-    rec = record if (hs, tp) == (1.0, 6.0) else _record(hs, tp)
+def test_heave_accuracy_meets_the_goal(hs, tp, model, duration, record):
+    """VesselMotion JONSWAP sea, default MEMS noise, 10 min after 2 min (30 min for the sea at
+    the goal's edge): real-time heave at the IMU and at a bow point 40 m away within max(2 cm,
+    2.5 % of the heave std), delayed heave within max(1 cm, 1 %) (the project's goals, beyond the
+    5 cm / 5 % of commercial MRUs); the band observer and the Wiener filter (model = "wiener").
+    The 30-min figures of every sea are the bench's (part heave)."""
+    rec = _head(record if (hs, tp) == (1.0, 6.0) else _record(hs, tp), duration)
     out, obs = _run(HeaveObserverParams(point=ARM, model=model), stack(rec, "imu.acc"), rec["truth.roll"],
                     rec["truth.pitch"])
     imu, pt, delayed, s_imu, s_pt = _errors(rec, out, obs)
