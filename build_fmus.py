@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
-"""Build every models/*.py into fmus/*.fmu, add units, and validate (see marinefmu.fmu.build)."""
+"""Build every models/*.py into fmus/*.fmu, each with the part of marinefmu its slaves run and a
+resources/requirements.txt; add units, validate, and verify that each runs from its own resources
+(see marinefmu.fmu.build). Prints each FMU's size."""
 import argparse
 import sys
 
