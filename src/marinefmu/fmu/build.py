@@ -465,7 +465,23 @@ def _fingerprint(script: Path, bundle: Bundle) -> str | None:
     return h.hexdigest()
 
 
-def _slave_units(script: Path) -> dict[str, str]:
+def repack(raw: Path, fmu: Path, unit_table: dict[str, str], extra: dict[str, str] | None = None) -> None:
+    """Copy the FMU pythonfmu wrote (``raw``) into ``fmu``, every entry deflated (pythonfmu stores
+    them uncompressed), with units and initial unknowns added to its modelDescription.xml
+    (:func:`marinefmu.fmu.units.postprocess_model_description`) and the ``extra`` files (path in
+    the FMU → text) added."""
+    with zipfile.ZipFile(raw) as zin, zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename == "modelDescription.xml":
+                data = units.postprocess_model_description(data, unit_table)
+            item.compress_type = zipfile.ZIP_DEFLATED
+            zout.writestr(item, data)
+        for name, text in (extra or {}).items():
+            zout.writestr(name, text)
+
+
+def slave_units(script: Path) -> dict[str, str]:
     """Instantiate the script's slave (its ``__init__`` is cheap) and read its unit table."""
     spec = importlib.util.spec_from_file_location(f"_marinefmu_build_{script.stem}", script)
     module = importlib.util.module_from_spec(spec)
@@ -502,15 +518,7 @@ def _build(script: Path, dest: Path, bundle: Bundle) -> str:
             shutil.copy2(PACKAGE_DIR / rel, stage / rel)
         raw = Path(FmuBuilder.build_FMU(script, dest=Path(tmp) / "raw", project_files=[stage],
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
-        unit_table = _slave_units(script)
-        with zipfile.ZipFile(raw) as zin, zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as zout:
-            for item in zin.infolist():
-                data = zin.read(item.filename)
-                if item.filename == "modelDescription.xml":
-                    data = units.postprocess_model_description(data, unit_table)
-                item.compress_type = zipfile.ZIP_DEFLATED   # pythonfmu stores its entries uncompressed
-                zout.writestr(item, data)
-            zout.writestr("resources/requirements.txt", requirements)
+        repack(raw, fmu, slave_units(script), {"resources/requirements.txt": requirements})
     with zipfile.ZipFile(fmu) as z:
         md_xml = z.read("modelDescription.xml")
     osp.write(md_xml, osp_file)

@@ -12,7 +12,6 @@ scan, :class:`~marinefmu.sea.recording.reader.Record`) before anything is built.
 from __future__ import annotations
 
 import gzip
-import importlib.util
 import shutil
 import tempfile
 import zipfile
@@ -22,8 +21,7 @@ from ..sea.recording.mapping import load_mapping
 from ..sea.recording.player import BUNDLE_DIR, BUNDLE_MAPPING
 from ..sea.recording.reader import Record, is_parquet
 from . import osp
-from .build import BuildError, repo_root, validate
-from .units import postprocess_model_description
+from .build import BuildError, repack, repo_root, slave_units, validate
 
 MODEL = "SensorRecording"
 #: The package bundled into the FMU's resources (as every marinefmu FMU bundles it).
@@ -32,14 +30,6 @@ PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
 def _script() -> Path:
     return repo_root() / "models" / f"{MODEL}.py"
-
-
-def _units(script: Path) -> dict[str, str]:
-    """The slave's unit table (its ``__init__`` is cheap)."""
-    spec = importlib.util.spec_from_file_location(f"_marinefmu_recording_build_{MODEL}", script)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return getattr(module, MODEL)(instance_name="build", resources=str(script.parent)).io.units
 
 
 def _bundle(record: Path, mapping: Path, folder: Path) -> Path:
@@ -81,13 +71,7 @@ def build_recording(record: str | Path, mapping: str | Path, output: str | Path)
         bundle = _bundle(record, mapping, Path(tmp) / "bundle")
         raw = Path(FmuBuilder.build_FMU(script, dest=tmp, project_files=[PACKAGE_DIR, bundle],
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
-        units = _units(script)
-        with zipfile.ZipFile(raw) as zin, zipfile.ZipFile(output, "w", zipfile.ZIP_DEFLATED) as zout:
-            for item in zin.infolist():
-                data = zin.read(item.filename)
-                if item.filename == "modelDescription.xml":
-                    data = postprocess_model_description(data, units)
-                zout.writestr(item, data)
+        repack(raw, output, slave_units(script))
     with zipfile.ZipFile(output) as z:
         md_xml = z.read("modelDescription.xml")
         names = z.namelist()

@@ -13,7 +13,7 @@ down, SI units, radians; the design page):
 
     [time]
     column = "time"
-    unit = "s"               # s, ms, us (or µs), ns, or iso8601 (text such as 2026-12-01T10:00:00.25Z)
+    unit = "s"               # s, ms, us (or µs), ns, or iso8601 (text such as YYYY-MM-DDThh:mm:ss.ffZ)
     rate = 10.24             # optional [Hz]: uniform samples whose stamps are only rounded: row k is at
                              # k / rate, each stamp checked to lie within half a sample of it
 
