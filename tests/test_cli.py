@@ -33,8 +33,8 @@ def test_simulate_writes_an_ssp_package_that_simulate_runs_again(fmu_dir, tmp_pa
     assert (first / "OspSystemStructure.xml").stat().st_size > 5000
     assert main(["simulate", str(first / "system.ssp"), "--duration", "3", "--out", str(second), "--no-progress"]) == 0
     a, b = load_csv(first / "results.csv"), load_csv(second / "results.csv")
-    # the scenario records time and its [record] list (68 variables); an .ssp has none: every output
-    assert len(a.dtype.names) == 69 and set(a.dtype.names) < set(b.dtype.names)
+    # the scenario records time and its [record] list (65 variables); an .ssp has none: every output
+    assert len(a.dtype.names) == 66 and set(a.dtype.names) < set(b.dtype.names)
     assert all(np.array_equal(a[f], b[f]) for f in a.dtype.names)
     assert np.std(a["fusion.pos.d"][100:]) > 0.01          # the estimators ran (GNSS fusion follows the heave)
     page = (first / "report.html").read_text()
