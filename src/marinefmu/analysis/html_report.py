@@ -63,7 +63,8 @@ LABELS = {
 }
 
 
-def _png(fig) -> str:
+def figure_png(fig) -> str:
+    """A matplotlib figure as a base64 PNG for an ``<img>`` tag (the figure is closed)."""
     import matplotlib.pyplot as plt
 
     buf = io.BytesIO()
@@ -100,7 +101,7 @@ def _diagram(system: SystemDescription, plt) -> str:
     ax.set_ylim(min(p[1] for p in pos.values()) - 0.7, max(p[1] for p in pos.values()) + 0.7)
     ax.axis("off")
     ax.set_title("System: boxes are FMU instances, arrows carry the number of connected variables", fontsize=9)
-    return _png(fig)
+    return figure_png(fig)
 
 
 def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) -> list[tuple[str, str]]:
@@ -131,7 +132,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
                             for a in ("roll", "pitch"))
                 if math.isfinite(worst) and worst > 0:
                     ax[1].set_ylim(-1.5 * worst, 1.5 * worst)
-            out.append((f"{c}: roll and pitch, the last minute and the error over the run", _png(fig)))
+            out.append((f"{c}: roll and pitch, the last minute and the error over the run", figure_png(fig)))
         elif kind == "HeaveObserver" and f"{c}.heave" in fields:
             valid = np.asarray(result[f"{c}.valid"], dtype=bool)
             fig, ax = plt.subplots(2, 1, figsize=(10, 5.5), sharex=True)
@@ -146,7 +147,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
                 ax[i].set_ylabel(f"heave at the {label} [m, up]")
                 ax[i].legend(loc="upper right", fontsize=8)
             ax[1].set_xlabel("time [s]")
-            out.append((f"{c}: heave in real time against the truth, the last minute", _png(fig)))
+            out.append((f"{c}: heave in real time against the truth, the last minute", figure_png(fig)))
             if valid.sum() > 2048:
                 from scipy import signal
 
@@ -165,7 +166,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
                 ax.set_xlabel("ω [rad/s]")
                 ax.set_ylabel("heave PSD [m²/Hz]")
                 ax.legend(fontsize=8)
-                out.append((f"{c}: heave spectra at the IMU (Welch) while valid", _png(fig)))
+                out.append((f"{c}: heave spectra at the IMU (Welch) while valid", figure_png(fig)))
         elif kind == "GnssAccFusion" and f"{c}.pos.d" in fields:
             fig, ax = plt.subplots(2, 1, figsize=(10, 5.5))
             for a, col in (("n", "tab:blue"), ("e", "tab:orange"), ("d", "tab:green")):
@@ -178,7 +179,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
             ax[1].set_ylim(-5, 5)
             ax[1].set_xlabel("time [s]")
             ax[1].legend(loc="upper right", fontsize=8)
-            out.append((f"{c}: GNSS + accelerometer fused COG position, the last minute and the error", _png(fig)))
+            out.append((f"{c}: GNSS + accelerometer fused COG position, the last minute and the error", figure_png(fig)))
         elif kind == "CentreOfRotation" and f"{c}.cr.x" in fields:
             fig, ax = plt.subplots(figsize=(10, 3.8))
             for a in "xyz":
@@ -188,7 +189,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
             ax.set_ylabel("centre of rotation [m, body, from COG]")
             ax.set_xlabel("time [s]")
             ax.legend(loc="upper right", ncol=3, fontsize=8)
-            out.append((f"{c}: convergence of the centre of rotation (settled running mean)", _png(fig)))
+            out.append((f"{c}: convergence of the centre of rotation (settled running mean)", figure_png(fig)))
         elif kind == "DisplacementReconstructor" and f"{c}.disp.d" in fields and f"{c}.delay" in fields:
             delay = float(g(f"{c}.delay")[-1])
             lag = int(round(delay / (t[1] - t[0])))
@@ -206,7 +207,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
                 ax.set_xlabel(f"time [s] (the estimate is available {delay:g} s later)")
                 ax.legend(loc="upper right", ncol=3, fontsize=8)
                 out.append((f"{c}: COG displacement reconstructed from acceleration alone (no GNSS), at the "
-                            f"window centre, {delay:g} s behind real time", _png(fig)))
+                            f"window centre, {delay:g} s behind real time", figure_png(fig)))
     winches = [c.name for c in system.components if c.kind == "AhcWinch" and f"{c.name}.load.d" in fields]
     tip = f"{vessel}.truth.point.d"
     if winches and tip in fields:
@@ -218,7 +219,7 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
         ax.set_ylabel("vertical motion about the mean [m, up]")
         ax.set_xlabel("time [s]")
         ax.legend(loc="upper right", ncol=3, fontsize=8)
-        out.append(("heave compensation: the crane tip and each winch's load, the last minute", _png(fig)))
+        out.append(("heave compensation: the crane tip and each winch's load, the last minute", figure_png(fig)))
     return out
 
 

@@ -26,14 +26,13 @@ gaps were longer than ``max_gap``, and on how many steps the sensor's ``valid`` 
 """
 from __future__ import annotations
 
-import base64
 import html
-import io
 from pathlib import Path
 
 import numpy as np
 
 from ..cosim.replay import REC, ReplayPlan
+from .html_report import figure_png
 
 #: (estimate, reference, reference valid, about the mean, what, unit of the score, factor from SI).
 PAIRS: tuple[tuple[str, str, str, bool, str, str, float], ...] = (
@@ -137,16 +136,6 @@ def validity_counts(result: np.ndarray, plan: ReplayPlan) -> list[tuple[str, int
     return rows
 
 
-def _png(fig) -> str:
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
-    fig.tight_layout()
-    fig.savefig(buf, format="png", dpi=90)
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode()
-
-
 def _figures(result: np.ndarray, plan: ReplayPlan, scores: dict[str, dict], plt) -> list[tuple[str, str]]:
     from scipy.signal import welch
 
@@ -168,7 +157,7 @@ def _figures(result: np.ndarray, plan: ReplayPlan, scores: dict[str, dict], plt)
         ax.set_ylabel(f"[{sc['unit']}]")
         ax.legend(fontsize=7, loc="upper right")
         figs.append((f"{est} against {pair[1]}: RMS {sc['rms']:.4g} {sc['unit']} at lag {sc['lag_s']:.3g} s "
-                     f"({lag} step(s))", _png(fig)))
+                     f"({lag} step(s))", figure_png(fig)))
     unscored = [n for n in names if n.split(".")[0] in plan.estimators and n not in scores
                 and result[n].dtype != bool and n.split(".", 1)[1] in _SHOWN]
     if unscored:
@@ -183,7 +172,7 @@ def _figures(result: np.ndarray, plan: ReplayPlan, scores: dict[str, dict], plt)
         a2.set_xlabel("frequency [Hz]")
         a2.set_ylabel("PSD")
         a1.legend(fontsize=6)
-        figs.append(("estimates without a reference in the record, and their spectra (Welch)", _png(fig)))
+        figs.append(("estimates without a reference in the record, and their spectra (Welch)", figure_png(fig)))
     flags = sorted(n for n in names if n.endswith("valid") and (n.split(".")[0] in plan.estimators or
                    (n.startswith(f"{REC}.") and _mapped_flag(plan, n))))
     if flags:
@@ -194,7 +183,7 @@ def _figures(result: np.ndarray, plan: ReplayPlan, scores: dict[str, dict], plt)
             ax.fill_between(t, i + 0.1, i + 0.9, where=~v, step="post", color="#c0392b", lw=0)
         ax.set_yticks(np.arange(len(flags)) + 0.5, flags, fontsize=7)
         ax.set_xlabel("time [s]")
-        figs.append(("validity timeline (green valid, red not)", _png(fig)))
+        figs.append(("validity timeline (green valid, red not)", figure_png(fig)))
     return figs
 
 

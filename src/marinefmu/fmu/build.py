@@ -481,6 +481,19 @@ def repack(raw: Path, fmu: Path, unit_table: dict[str, str], extra: dict[str, st
             zout.writestr(name, text)
 
 
+def check_and_describe(fmu: Path, osp_file: Path) -> None:
+    """Write the OSP model description of ``fmu`` to ``osp_file``, then validate both
+    (``fmpy.validation.validate_fmu`` and :func:`marinefmu.fmu.osp.check`); an FMU with problems is
+    deleted and refused."""
+    with zipfile.ZipFile(fmu) as z:
+        md_xml = z.read("modelDescription.xml")
+    osp.write(md_xml, osp_file)
+    problems = validate(fmu) + osp.check(md_xml, osp_file.read_bytes())
+    if problems:
+        fmu.unlink()
+        raise BuildError(f"{fmu.name} failed validation:\n  " + "\n  ".join(problems))
+
+
 def slave_units(script: Path) -> dict[str, str]:
     """Instantiate the script's slave (its ``__init__`` is cheap) and read its unit table."""
     spec = importlib.util.spec_from_file_location(f"_marinefmu_build_{script.stem}", script)
@@ -519,13 +532,7 @@ def _build(script: Path, dest: Path, bundle: Bundle) -> str:
         raw = Path(FmuBuilder.build_FMU(script, dest=Path(tmp) / "raw", project_files=[stage],
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
         repack(raw, fmu, slave_units(script), {"resources/requirements.txt": requirements})
-    with zipfile.ZipFile(fmu) as z:
-        md_xml = z.read("modelDescription.xml")
-    osp.write(md_xml, osp_file)
-    problems = validate(fmu) + osp.check(md_xml, osp_file.read_bytes())
-    if problems:
-        fmu.unlink()
-        raise BuildError(f"{fmu.name} failed validation:\n  " + "\n  ".join(problems))
+    check_and_describe(fmu, osp_file)
     return fingerprint
 
 

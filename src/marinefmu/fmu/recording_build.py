@@ -20,8 +20,7 @@ from pathlib import Path
 from ..sea.recording.mapping import load_mapping
 from ..sea.recording.player import BUNDLE_DIR, BUNDLE_MAPPING
 from ..sea.recording.reader import Record, is_parquet
-from . import osp
-from .build import BuildError, repack, repo_root, slave_units, validate
+from .build import BuildError, check_and_describe, repack, repo_root, slave_units
 
 MODEL = "SensorRecording"
 #: The package bundled into the FMU's resources (as every marinefmu FMU bundles it).
@@ -73,15 +72,9 @@ def build_recording(record: str | Path, mapping: str | Path, output: str | Path)
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
         repack(raw, output, slave_units(script))
     with zipfile.ZipFile(output) as z:
-        md_xml = z.read("modelDescription.xml")
         names = z.namelist()
     if f"resources/{BUNDLE_DIR}/{BUNDLE_MAPPING}" not in names:
         output.unlink()
         raise BuildError(f"{output.name}: the bundled record did not reach resources/{BUNDLE_DIR}/")
-    osp_file = output.with_name(f"{output.stem}_OspModelDescription.xml")
-    osp.write(md_xml, osp_file)
-    problems = validate(output) + osp.check(md_xml, osp_file.read_bytes())
-    if problems:
-        output.unlink()
-        raise BuildError(f"{output.name} failed validation:\n  " + "\n  ".join(problems))
+    check_and_describe(output, output.with_name(f"{output.stem}_OspModelDescription.xml"))
     return output
