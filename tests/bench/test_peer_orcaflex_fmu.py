@@ -28,7 +28,7 @@ def test_fmu_path_gives_the_in_process_figures(fmu_dir):
     np.testing.assert_array_equal(runs.gnss, rec.gnss)
     np.testing.assert_array_equal(runs.heading, rec.heading)
     acc_n, gyro_n = po.sensor_noise(rec)
-    ours = estimate_attitude(rec.gyro, rec.acc, 1.0 / po.RATE, AttitudeEstimatorParams(acc_noise=acc_n, gyro_noise=gyro_n))
+    ours = estimate_attitude(rec.gyro, rec.acc, 1.0 / po.RATE, AttitudeEstimatorParams(acc_noise=acc_n, gyro_noise=gyro_n, **po.FIXED_AIDING))
     np.testing.assert_array_equal(runs.roll, ours["roll"])  # the same estimator, sample for sample
     np.testing.assert_array_equal(runs.pitch, ours["pitch"])
     k0 = po.SETTLE_SAMPLES
