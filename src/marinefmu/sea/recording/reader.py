@@ -11,8 +11,15 @@ to any time (FMU state restore) by reading one block, and counts each sensor's b
 An empty field is "no sample in this row" (a GNSS epoch in a record that interleaves a 5 Hz
 receiver with a 100 Hz IMU); ``nan`` (or ``inf``) written in a field is a bad sample.
 
-Parquet needs the optional package ``pyarrow``; without it a Parquet record is refused with a
-message saying so.
+Parquet needs the optional package ``pyarrow`` (``pip install marinefmu[parquet]``); without it
+a Parquet record is refused with a message saying so. A Parquet record has no lines: its messages
+name the row instead, counted from 0 among the data rows. Its mapped columns may be integer,
+floating-point, boolean or decimal, or text holding numbers as a CSV field would (surrounding
+blanks ignored); a null is an empty field (no sample), a NaN a bad sample. Any other type (a
+timestamp, binary, a list ...) is refused naming the column and its type, text that is not a
+number naming the row. The time column with ``time.unit = "iso8601"`` is a Parquet timestamp
+(with a time zone: taken in UTC) or ISO-8601 text, read as in a CSV; with a numeric unit it is a
+number like any other column.
 """
 from __future__ import annotations
 
@@ -152,8 +159,14 @@ class Record:
         self.scan()
 
     # --- the file -----------------------------------------------------------------------------
+    @property
+    def _line_word(self) -> str:
+        """What a position in the file is called in a message: a CSV line, a Parquet row."""
+        return "row" if self.parquet else "line"
+
     def _fail(self, what: str, line: int | None = None, column: str | None = None) -> RecordingError:
-        where = "".join(f", {w}" for w in (f"line {line}" if line else "", f"column {column!r}" if column else "") if w)
+        at = f"{self._line_word} {line}" if line is not None and (line or self.parquet) else ""
+        where = "".join(f", {w}" for w in (at, f"column {column!r}" if column else "") if w)
         return RecordingError(f"record {self.path}{where}: {what}")
 
     def _read_header(self) -> list[str]:
@@ -196,7 +209,8 @@ class Record:
         try:
             import pyarrow.parquet as pq
         except ImportError:
-            raise self._fail("is a Parquet file, which needs the optional package pyarrow (pip install pyarrow); "
+            raise self._fail("is a Parquet file, which needs the optional package pyarrow (pip install marinefmu[parquet], "
+                             "or pip install pyarrow); "
                              "or convert it to CSV") from None
         try:
             return pq.ParquetFile(self.path)
@@ -316,29 +330,81 @@ class Record:
         return self._fail("cannot be parsed (inconsistent number of fields)", line=int(line_numbers[0]))
 
     def _parquet_blocks(self, start_block: int):
+        """Yield (row numbers, raw columns, times or None) for each batch from ``start_block``;
+        the row numbers count the data rows from 0 (a Parquet file has no lines)."""
         pf = self._parquet()
         m = self.mapping
         row = 0
         k = 0
         for batch in pf.iter_batches(batch_size=BLOCK_ROWS, columns=list(self._index)):
             n = batch.num_rows
+            if not n:        # an empty row group: no block (the blocks are counted the same on every read)
+                continue
             if k >= start_block:
                 if k >= len(self._offsets):
                     self._offsets.append(row)
-                    self._lines.append(row + 2)
+                    self._lines.append(row)
+                rows = np.arange(n, dtype=np.int64) + row
                 raw, times = {}, None
                 for c in self._index:
                     arr = batch.column(c)
                     if c == m.time_column and m.time_unit == "iso8601":
-                        times = np.asarray(arr.cast("timestamp[ns]").to_numpy(zero_copy_only=False))
-                        continue
-                    try:
-                        raw[c] = np.asarray(arr.cast("double").to_numpy(zero_copy_only=False), dtype=float)
-                    except Exception:  # noqa: BLE001 - pyarrow's cast error
-                        raise self._fail(f"has non-numeric values ({arr.type})", column=c) from None
-                yield np.arange(n) + row + 2, raw, times
+                        times = self._parquet_times(arr, rows)
+                    else:
+                        raw[c] = self._parquet_numbers(arr, rows, c)
+                yield rows, raw, times
             row += n
             k += 1
+
+    def _parquet_numbers(self, arr, rows: np.ndarray, column: str) -> np.ndarray:
+        """A Parquet column as float, null → the empty marker (module docstring: accepted types)."""
+        import pyarrow as pa
+        import pyarrow.compute as pc
+
+        if pa.types.is_dictionary(arr.type):
+            arr = arr.dictionary_decode()
+        t = arr.type
+        if pa.types.is_string(t) or pa.types.is_large_string(t):
+            arr = pc.utf8_trim_whitespace(arr)
+            arr = pc.if_else(pc.equal(arr, ""), pa.scalar(None, arr.type), arr)
+            try:
+                arr = arr.cast(pa.float64())
+            except (pa.ArrowInvalid, pa.ArrowNotImplementedError):   # Python's float(), as a CSV field
+                out = np.empty(len(arr))
+                for i, v in enumerate(arr.to_pylist()):
+                    try:
+                        out[i] = _EMPTY_VALUE if v is None else float(v)
+                    except ValueError:
+                        raise self._fail(f"{v!r} is not a number", line=int(rows[i]), column=column) from None
+                return out
+        elif not (pa.types.is_integer(t) or pa.types.is_floating(t) or pa.types.is_boolean(t)
+                  or pa.types.is_decimal(t) or pa.types.is_null(t)):
+            hint = ' (set time.unit = "iso8601" for a timestamp time column)' if (
+                column == self.mapping.time_column and (pa.types.is_timestamp(t) or pa.types.is_date(t))) else ""
+            raise self._fail(f"has non-numeric values (Parquet type {t}){hint}", column=column)
+        else:
+            arr = arr.cast(pa.float64())
+        # a copy: the block converts in place, and pyarrow's zero-copy arrays are read-only
+        return np.array(arr.fill_null(_EMPTY_VALUE).to_numpy(zero_copy_only=False), dtype=float)
+
+    def _parquet_times(self, arr, rows: np.ndarray) -> np.ndarray:
+        """The time column of ``time.unit = "iso8601"``: a Parquet timestamp (UTC if it has a time
+        zone) or ISO-8601 text (as in a CSV), to datetime64[ns]; a null is NaT (refused later)."""
+        import pyarrow as pa
+
+        if pa.types.is_dictionary(arr.type):
+            arr = arr.dictionary_decode()
+        t = arr.type
+        if pa.types.is_timestamp(t) or pa.types.is_date(t):
+            return np.asarray(arr.cast(pa.timestamp("ns")).to_numpy(zero_copy_only=False), dtype="datetime64[ns]")
+        if not (pa.types.is_string(t) or pa.types.is_large_string(t)):
+            raise self._fail(f"is Parquet type {t}: time.unit = 'iso8601' needs a timestamp or ISO-8601 text column",
+                             column=self.mapping.time_column)
+        texts = arr.to_pylist()
+        missing = [i for i, v in enumerate(texts) if v is None or not v.strip()]
+        if missing:
+            raise self._fail("time stamp is missing", line=int(rows[missing[0]]), column=self.mapping.time_column)
+        return self._iso(np.array(texts, dtype=str), rows)
 
     # --- the scan and the conversion -----------------------------------------------------------
     def _times(self, raw: dict[str, np.ndarray], times: np.ndarray | None, line_numbers: np.ndarray,
@@ -425,7 +491,7 @@ class Record:
                 i = int(np.argmax(bad))
                 prev_line = int(line_numbers[i - 1]) if i > 0 else last_line
                 how = "repeats" if dt[i] == 0.0 else "goes backwards"
-                raise self._fail(f"time stamp {how} (from line {prev_line}): time stamps must increase",
+                raise self._fail(f"time stamp {how} (from {self._line_word} {prev_line}): time stamps must increase",
                                  line=int(line_numbers[i]), column=m.time_column)
             block = self._block(rows, raw, t)
             self._block_times.append(float(t[0]))
@@ -449,7 +515,7 @@ class Record:
                     keep = None
             last_t, last_line = float(t[-1]), int(line_numbers[-1])
         if rows == 0:
-            raise self._fail("has no data rows after the header")
+            raise self._fail("has no data rows" + ("" if self.parquet else " after the header"))
         if keep is not None:
             self._cache = dict(enumerate(keep))
             self._pinned = True
