@@ -47,6 +47,16 @@ taken at the window centre, so the filter runs ``delay`` = diff_window/2 behind 
 sample, without phase error between α and the accelerations. The paper does not say how it
 differentiates.
 
+**No rotation** (a vessel in harbour): the offset is observable only through α (and ω), so
+with no rotation there is nothing to estimate it from, and a gyro's noise differentiated into α
+is then taken for rotation: it pulls the offset towards the sensor (errors in variables) and
+shrinks its covariance for no information. So the RMS of |α| over the last
+:data:`EXCITATION_TAU` s is compared with :data:`MIN_ANG_ACC`; below it the offset is held (its
+columns of H and its covariance with a_CR are zeroed, so the measurements do not move it and
+its variance grows only by ``offset_rw``), ``valid`` is false, and a warning saying why is
+logged once each time the rotation falls below the bound. In waves α is one to two orders of
+magnitude above the bound and nothing changes.
+
 Outputs: the offset and its standard deviation (filter covariance), its running mean after
 ``settle_time`` (the paper averages "after the Kalman filter has reached a settled state"), the
 CR relative to the COG for a sensor at ``sensor`` (COG frame), the specific force a sensor at
@@ -78,6 +88,17 @@ ANGLE_CHOICES = ("gyro_hp", "input")
 #: loses 0.16 % at 0.2 Hz and 0.8 % at 0.3 Hz while averaging the gyro noise enough that it does
 #: not shrink the offset (noise in α biases the estimate towards the sensor).
 POLYORDER = 4
+#: Least RMS angular acceleration |α| [rad/s²] from which the offset is estimated (module
+#: docstring, "No rotation"): about 4 times the RMS |α| that the default MEMS gyro's white noise
+#: (5e-5 rad/s/√Hz) gives through the default 1.5 s derivative (2.3e-4 rad/s² per axis, 4e-4
+#: for the vector, at any sample rate), and under 1/50 of that of a 36 m vessel in a 1.5 m sea
+#: (0.058 rad/s², :mod:`marinefmu.papers.paper002`).
+MIN_ANG_ACC = 1e-3
+#: Memory of the running mean square of |α| that is compared with :data:`MIN_ANG_ACC` [s] ...
+EXCITATION_TAU = 30.0
+#: ... which is judged once it holds this long [s] of filtered samples (the mean is corrected
+#: for its start; a single sample at a zero crossing of α would say nothing).
+EXCITATION_MIN = 1.0
 
 
 @dataclass(frozen=True)
@@ -299,7 +320,8 @@ class CentreOfRotationResult:
     delay : float
         How far the estimate lags the newest sample [s].
     valid : bool
-        Window full and the sample good.
+        Window full, the sample good, and enough rotation to observe the offset
+        (:data:`MIN_ANG_ACC`).
     settled : bool
         ``settle_time`` has passed, so ``offset_mean`` is an average.
     warning : str or None
@@ -361,6 +383,12 @@ class CentreOfRotation:
         self.filtered_time = 0.0
         self.mean_sum = np.zeros(3)
         self.mean_count = 0
+        # running mean square of |α| [rad²/s⁴], its start-corrected weight, the time it holds [s],
+        # and whether the offset is held for want of rotation (module docstring, "No rotation")
+        self.alpha_ms = 0.0
+        self.alpha_weight = 0.0
+        self.alpha_time = 0.0
+        self.unobservable = False
         self.kf = KalmanFilter(dim_x=6, dim_z=3)
         self.kf.P = np.diag([1.0] * 3 + [p.offset_sigma0 ** 2] * 3)
         self.kf.R = np.eye(3) * p.acc_sigma ** 2
@@ -421,18 +449,44 @@ class CentreOfRotation:
             return self._invalid(warning)
         raw, smooth, deriv = centre
         omega, alpha, f_b, angles = smooth[0:3], deriv[0:3], raw[3:6], raw[6:9].tolist()
+        observable = self._excitation(alpha, dt)
         rot = rot_nb(*angles)
         kf = self.kf
         kf.predict()
         # set H rather than pass it: filterpy's update() reshapes z to a column only when H is None
         kf.H = measurement_matrix(rot, omega, alpha, p.centripetal)
+        if not observable:
+            # no rotation: the offset is held (module docstring, "No rotation"); without its
+            # covariance with a_CR the a_CR innovations do not move it either
+            kf.H[:, 3:6] = 0.0
+            kf.P[0:3, 3:6] = kf.P[3:6, 0:3] = 0.0
         kf.update(f_b + rot.T @ GRAVITY_N)
         self.filtered_time += dt
         if self.filtered_time >= p.settle_time - 1e-9:
             self.mean_sum += kf.x[3:6, 0]
             self.mean_count += 1
-        self._result = self._output(f_b, alpha, angles, warning is None, warning)
+        self._result = self._output(f_b, alpha, angles, warning is None and observable, warning)
         return self._result
+
+    def _excitation(self, alpha: np.ndarray, dt: float) -> bool:
+        """Update the running mean square of |α| [rad/s²] and say whether the rotation is enough
+        to observe the offset (:data:`MIN_ANG_ACC`); log when it stops being enough."""
+        beta = dt / EXCITATION_TAU
+        self.alpha_ms += beta * (float(alpha @ alpha) - self.alpha_ms)
+        self.alpha_weight += beta * (1.0 - self.alpha_weight)
+        self.alpha_time += dt
+        if self.alpha_time < EXCITATION_MIN - 1e-9:
+            return True
+        rms = math.sqrt(self.alpha_ms / self.alpha_weight)
+        if rms < MIN_ANG_ACC and not self.unobservable:
+            log.warning("centre of rotation: no rotation to observe the offset by (RMS angular acceleration "
+                        "%.2g rad/s² over the last %g s < %g): offset held, valid = false", rms, EXCITATION_TAU,
+                        MIN_ANG_ACC)
+        elif rms >= MIN_ANG_ACC and self.unobservable:
+            log.info("centre of rotation: rotation again (RMS angular acceleration %.2g rad/s²): offset estimated",
+                     rms)
+        self.unobservable = rms < MIN_ANG_ACC
+        return not self.unobservable
 
     def _invalid(self, warning: str | None) -> CentreOfRotationResult:
         return replace(self._result, delay=self.delay, valid=False, warning=warning)
@@ -465,6 +519,8 @@ class CentreOfRotation:
             "euler": list(self.euler), "last": last, "filtered_time": self.filtered_time,
             "mean_sum": self.mean_sum.tolist(), "mean_count": self.mean_count,
             "kf_x": self.kf.x.tolist(), "kf_P": self.kf.P.tolist(),
+            "alpha_ms": self.alpha_ms, "alpha_weight": self.alpha_weight, "alpha_time": self.alpha_time,
+            "unobservable": self.unobservable,
         }
 
     def set_state(self, s: dict) -> None:
@@ -478,6 +534,8 @@ class CentreOfRotation:
         self.filtered_time = float(s["filtered_time"])
         self.mean_sum, self.mean_count = np.array(s["mean_sum"]), int(s["mean_count"])
         self.kf.x, self.kf.P = np.array(s["kf_x"]), np.array(s["kf_P"])
+        self.alpha_ms, self.alpha_weight = float(s["alpha_ms"]), float(s["alpha_weight"])
+        self.alpha_time, self.unobservable = float(s["alpha_time"]), bool(s["unobservable"])
 
 
 def estimate_centre_of_rotation(acc: np.ndarray, gyro: np.ndarray, dt: float,

@@ -2,6 +2,10 @@
 ``model="band"`` comb): the spectrum, its peaks or band weights, a steady-state Kalman filter over
 the oscillator bank, the transfer to a point and the fixed-lag smoother. The method and its
 equations are set out in :mod:`.common`.
+
+A spectrum with no peak or band energy (a vessel in harbour, a constant input) keeps the model
+the observer has, and before the first one there is none, so ``valid`` stays false; that is
+logged once when it starts, not at every ``peak_interval`` for as long as the vessel lies still.
 """
 from __future__ import annotations
 
@@ -65,6 +69,7 @@ class OscillatorBankHeave:
         self.angles: list[tuple[float, float]] = []
         self.last_angles = (0.0, 0.0)
         self.peak_period = 0.0
+        self.no_sea = False                     # the last spectrum had no peak (logged once: module docstring)
         self.smoother: FixedLagOutputs | None = None
         self._delayed: tuple[np.ndarray, np.ndarray] | None = None
         self._aux = np.zeros(4)
@@ -198,8 +203,12 @@ class OscillatorBankHeave:
         else:
             omega, variance = modes.omega, None
         if len(modes) == 0 or len(omega) == 0:
-            self.log.warning("heave observer: no spectral peak in [%g, %g] rad/s; modes unchanged", p.omega_min, p.omega_max)
+            if not self.no_sea:
+                self.log.warning("heave observer: no spectral peak in [%g, %g] rad/s; %s", p.omega_min, p.omega_max,
+                                 "no modes yet, valid = false" if self.model is None else "modes unchanged")
+            self.no_sea = True
             return False
+        self.no_sea = False
         self.peak_period = 2.0 * math.pi / float(modes.omega[np.argmax(modes.amplitude)])
         new = self._build(omega, variance)
         if self.model is not None:
@@ -306,7 +315,7 @@ class OscillatorBankHeave:
             "xp": arr(self.xp), "x": arr(self.x),
             "prev": None if self.prev is None else [self.prev[0], self.prev[1].tolist()],
             "angles": [list(a) for a in self.angles], "last_angles": list(self.last_angles),
-            "peak_period": self.peak_period, "aux": self._aux.tolist(),
+            "peak_period": self.peak_period, "no_sea": self.no_sea, "aux": self._aux.tolist(),
             "delayed": None if self._delayed is None else [v.tolist() for v in self._delayed],
             "smoother": None if self.smoother is None else self.smoother.get_state(), "result": self._result.__dict__,
         }
@@ -327,6 +336,7 @@ class OscillatorBankHeave:
         self.angles = [tuple(a) for a in s["angles"]]
         self.last_angles = tuple(s["last_angles"])
         self.peak_period = float(s["peak_period"])
+        self.no_sea = bool(s["no_sea"])
         self._aux = np.array(s["aux"], dtype=float)
         self._delayed = None if s["delayed"] is None else tuple(np.array(v) for v in s["delayed"])
         self.smoother.set_state(s["smoother"])

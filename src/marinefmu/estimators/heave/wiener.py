@@ -45,6 +45,11 @@ sample on, and of every sample to come (the ``offset`` output includes it), and 
 estimated again at every check for :data:`STEP_REFINE_AGE` s as the record after it grows. The
 heave is then the heave of the run without the step (test). A warning is logged for each step.
 
+No sea (a vessel in harbour, a constant input): a design that finds no density above the
+sensor's noise keeps the filter it has, and before the first one there is none, so ``valid``
+stays false. That is logged once when it starts, not at every design (every ``peak_interval``
+for as long as the vessel lies still).
+
 Bad samples (NaN, Inf, absurd values, :func:`~.common.read_sample`) enter the filter as the
 window's mean (zero acceleration: the estimate decays to zero over the memory rather than
 drifting), ``valid`` is false and a warning is logged. A change of step size restarts.
@@ -228,6 +233,7 @@ class WienerHeave:
         self.step_at: int | None = None      # sample index of the last step found (refined as it ages)
         self.peak_period = 0.0
         self.peaks: tuple[float, ...] = ()   # frequencies of the sea's spectral peaks [rad/s]
+        self.no_sea = False                  # the last design found no sea (logged once: module docstring)
 
     def start(self, dt: float) -> None:
         p = self.params
@@ -270,9 +276,13 @@ class WienerHeave:
         sea = np.where((spectrum.omega >= p.omega_min) & (spectrum.omega <= p.omega_max), excess / spectrum.omega**4,
                        0.0)
         if not np.any(sea > 0.0):
-            self.log.warning("wiener heave: no sea above the noise in [%g, %g] rad/s; filter unchanged",
-                             p.omega_min, p.omega_max)
+            if not self.no_sea:
+                self.log.warning("wiener heave: no sea above the accelerometer noise in [%g, %g] rad/s; %s",
+                                 p.omega_min, p.omega_max, "no filter yet, valid = false" if self.taps is None
+                                 else "filter unchanged")
+            self.no_sea = True
             return
+        self.no_sea = False
         self.peak_period = 2.0 * math.pi / float(spectrum.omega[np.argmax(sea)])
         found = find_modes(replace(spectrum, position_amplitude=np.sqrt(sea)), p.omega_min, p.omega_max,
                            p.max_modes, p.min_separation, p.min_relative)
@@ -373,7 +383,7 @@ class WienerHeave:
                 "sum_buf": arr(self.sum_buf), "total": self.total, "angle_buf": arr(self.angle_buf),
                 "taps": arr(self.taps),
                 "mean": self.mean, "level": self.level, "step_at": self.step_at, "peak_period": self.peak_period,
-                "peaks": list(self.peaks)}
+                "peaks": list(self.peaks), "no_sea": self.no_sea}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -391,3 +401,4 @@ class WienerHeave:
         self.mean, self.level, self.peak_period = float(s["mean"]), float(s["level"]), float(s["peak_period"])
         self.step_at = None if s["step_at"] is None else int(s["step_at"])
         self.peaks = tuple(float(w) for w in s["peaks"])
+        self.no_sea = bool(s["no_sea"])
