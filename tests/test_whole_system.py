@@ -21,7 +21,7 @@ LIBCOSIM_DURATION = 300.0
 ESTIMATES = {
     "att": ["roll", "pitch", "yaw", "q.w", "gyro_bias.x", "valid"],
     "recon": ["disp.n", "disp.e", "disp.d", "vel.d", "delay", "valid"],
-    "fusion": ["pos.n", "pos.e", "pos.d", "vel.d", "roll", "pos_std.d", "valid"],
+    "fusion": ["pos.n", "pos.e", "pos.d", "vel.d", "roll_used", "pos_std.d", "valid"],
     "cr": ["offset.x", "offset.y", "offset.z", "cr.x", "cr.y", "cr.z", "valid"],
     "heave": ["heave", "heave_rate", "point.heave", "delayed.heave", "offset", "peak_period", "valid"],
 }

@@ -24,22 +24,24 @@ Errors are scored, as smsfusion's test does, from sample 600 (58.6 s) on.
   beside it.
 - **GNSS-aided position** (1 Hz fixes, every 10th sample, as smsfusion's test aids its INS):
   the fusion filter of :mod:`~marinefmu.estimators.gnss_fusion` on one receiver
-  (:func:`~marinefmu.estimators.gnss_fusion.runs.fuse_receiver`; the specific force rotated
-  with the AttitudeEstimator's roll and pitch and the compass heading) against smsfusion's
-  ``AidedINS`` aided by the same fixes and compass. The fusion's ``q`` and ``q_down`` are not
+  (:class:`~marinefmu.estimators.gnss_fusion.filter.GnssAccFusion` with ``attitude =
+  "input"``: the specific force rotated with the AttitudeEstimator's roll and pitch and the
+  compass heading, the receiver at the IMU) against smsfusion's ``AidedINS`` aided by the same
+  fixes and compass. The fusion's ``q`` and ``q_down`` are not
   tuned on this record: :func:`tune_receiver_q` picks them on a VesselMotion record with the
   same sensors (a grid, the truth of our own simulator) and :data:`RECEIVER_Q` holds its
   result, checked by a test.
 
 **Through the FMUs** (:func:`fmu_runs`, ``compare_orcaflex(fmu_dir=…)``): the record is played by
 the SensorRecording FMU (mapping :data:`MAPPING`, the worked example
-``examples/recordings/orcaflex.toml``) into the AttitudeEstimator and HeaveObserver FMUs, wired
-as ``marinefmu replay`` wires them; the one-receiver fusion, which needs the specific force
-rotated by the estimated attitude and the compass (no FMU does that rotation), runs in-process
-on what the recording FMU and the AttitudeEstimator FMU output. The attitude and the fusion are
-then the in-process figures exactly; the heave differs in the last digits, because under the
-co-simulation's one-step coupling the HeaveObserver gets the roll and pitch of the previous
-sample (in-process: of the same sample).
+``examples/recordings/orcaflex.toml``, with a ``new`` column that marks every 10th sample's fix)
+into the AttitudeEstimator, HeaveObserver and GnssAccFusion (``attitude = "input"``, yaw from
+the compass) FMUs, wired as ``marinefmu replay`` wires them. The attitude is then the
+in-process figure exactly. Under the co-simulation's one-step coupling the HeaveObserver and
+the fusion get the roll and pitch of the previous sample (in-process: of the same sample); the
+fusion turns them forward with the gyro (``attitude_lag`` one step), and their figures differ
+from the in-process ones in the last digits. On the inputs it was given, the fusion FMU is the
+in-process estimator exactly (a test).
 """
 from __future__ import annotations
 
@@ -235,19 +237,32 @@ def rotate_to_ned(acc: np.ndarray, roll: np.ndarray, pitch: np.ndarray, yaw: np.
     return np.einsum("kij,kj->ki", rot, acc)
 
 
-def receiver_fusion(f_n: np.ndarray, gnss: np.ndarray, dt: float, q: tuple[float, float]) -> np.ndarray:
-    """Position [m, NED] of the one-receiver fusion with a fix every :data:`FIX_EVERY` samples,
-    R = :data:`RECEIVER_SIGMA`² (r = σ²Δt), and ``q`` = (q, q_down).
+def fusion_parameters(dt: float, q: tuple[float, float], lag: float = 0.0) -> dict[str, Any]:
+    """The one-receiver fusion's settings, FMI-named (the GnssAccFusion FMU's and, through
+    :func:`~marinefmu.fmu.tables.fusion_params`, :func:`receiver_fusion`'s): ``attitude =
+    "input"``, the receiver and the accelerometer at the IMU point (the record's origin; no lever
+    arm), R = :data:`RECEIVER_SIGMA`² (r = σ²Δt for the step ``dt``), ``q`` = (q, q_down), and
+    ``attitude_lag`` = ``lag`` [s] (one step through the FMUs: the co-simulation's coupling).
 
-    ``coast="inertial"``: the records have no gap longer than the 2 s after which the default
+    ``coast = "inertial"``: the records have no gap longer than the 2 s after which the default
     wave-model coast would start, so it would only cost time (its band observers are 95 % of
     the run) and change nothing."""
-    from ..estimators.gnss_fusion.runs import fuse_receiver
-    from ..estimators.gnss_fusion.filter import GnssAccFusionParams
+    at_imu = {f"{v}.{a}": 0.0 for v in ("ant1", "acc_lever_arm") for a in "xyz"}
+    return {"attitude": "input", "attitude_lag": lag, "q": q[0], "q_down": q[1], "r": RECEIVER_SIGMA ** 2 * dt,
+            "coast": "inertial", **at_imu}
 
-    new = np.arange(len(f_n)) % FIX_EVERY == 0
-    params = GnssAccFusionParams(q=q[0], q_down=q[1], r=RECEIVER_SIGMA ** 2 * dt, coast="inertial")
-    return fuse_receiver(f_n, dt, gnss, new, params)["pos"]
+
+def receiver_fusion(acc: np.ndarray, euler: np.ndarray, gnss: np.ndarray, dt: float, q: tuple[float, float],
+                    gyro: np.ndarray | None = None, lag: float = 0.0) -> np.ndarray:
+    """Position [m, NED] of the one-receiver fusion (:func:`fusion_parameters`) with a fix every
+    :data:`FIX_EVERY` samples: ``acc`` (N, 3) the specific force [m/s², body], ``euler`` (N, 3)
+    the roll, pitch, yaw [rad] that rotate it (their roll and pitch ``lag`` s late, turned
+    forward with ``gyro`` (N, 3) [rad/s, body]), ``gnss`` (N, 3) the receiver [m, NED]."""
+    from ..estimators.gnss_fusion.runs import fuse
+    from ..fmu.tables import fusion_params
+
+    new = np.arange(len(acc)) % FIX_EVERY == 0
+    return fuse(acc, dt, gnss, new, gyro, fusion_params(fusion_parameters(dt, q, lag)), euler=euler)["pos"]
 
 
 def aided_ins_run(rec: OrcaflexRecord) -> np.ndarray:
@@ -285,8 +300,15 @@ class FmuRuns:
         (N,) the AttitudeEstimator FMU's roll and pitch after each sample [rad].
     heave, heave_valid, heave_band, heave_band_valid : numpy.ndarray
         (N,) the HeaveObserver FMUs' heave [m, down] and valid (default model and ``band``).
-    acc, gnss : numpy.ndarray
-        (N, 3) specific force [m/s², body] and position [m, NED] as the recording FMU played them.
+    pos : numpy.ndarray
+        (N, 3) the GnssAccFusion FMU's position after each sample [m, NED].
+    fusion_euler : numpy.ndarray
+        (N, 3) the roll, pitch, yaw [rad] the fusion FMU was given with each sample: the
+        AttitudeEstimator's after the previous sample (the one-step coupling, which the fusion's
+        ``attitude_lag`` turns forward) and the compass.
+    acc, gyro, gnss : numpy.ndarray
+        (N, 3) specific force [m/s², body], angular rate [rad/s, body] and position (held between
+        the fixes) [m, NED] as the recording FMU played them.
     heading : numpy.ndarray
         (N,) the compass [rad] as played.
     """
@@ -297,16 +319,37 @@ class FmuRuns:
     heave_valid: np.ndarray
     heave_band: np.ndarray
     heave_band_valid: np.ndarray
+    pos: np.ndarray
+    fusion_euler: np.ndarray
     acc: np.ndarray
+    gyro: np.ndarray
     gnss: np.ndarray
     heading: np.ndarray
 
 
+def _record_with_fixes(path: Path, dest: Path) -> None:
+    """The record with a column ``fix_new``, 1 on every :data:`FIX_EVERY`-th sample (the
+    harness's 1 Hz fixes; the record has a position on every sample), written to ``dest``."""
+    with (gzip.open(path, "rt") if path.suffix == ".gz" else open(path)) as fh:
+        lines = [line.rstrip("\n") for line in fh if line.strip()]
+    rows = [f"{lines[0]},fix_new", *(f"{line},{int(k % FIX_EVERY == 0)}" for k, line in enumerate(lines[1:]))]
+    dest.write_text("\n".join(rows) + "\n", encoding="utf-8")
+
+
+def fix_mapping() -> str:
+    """:data:`MAPPING` with the GNSS epochs marked by the column ``fix_new`` of
+    :func:`_record_with_fixes` (and a ``max_gap`` longer than their interval)."""
+    old = '[gnss]\nmax_gap = 0.25\n'
+    if old not in MAPPING:
+        raise RuntimeError("MAPPING has no [gnss] max_gap = 0.25 to mark the fixes in")
+    return MAPPING.replace(old, '[gnss]\nmax_gap = 2.0\nnew = "fix_new"\n')
+
+
 def fmu_runs(fmu_dir: str | Path, rec: OrcaflexRecord | None = None, path: str | Path | None = None,
              band: bool = True) -> FmuRuns:
-    """Play the record through the SensorRecording, AttitudeEstimator and HeaveObserver FMUs
-    (module docstring); ``path`` the record (default the packaged one); ``band`` also runs a
-    HeaveObserver with ``model = "band"`` (else its fields are NaN / false)."""
+    """Play the record through the SensorRecording, AttitudeEstimator, HeaveObserver and
+    GnssAccFusion FMUs (module docstring); ``path`` the record (default the packaged one);
+    ``band`` also runs a HeaveObserver with ``model = "band"`` (else its fields are NaN / false)."""
     import tempfile
 
     from ..cosim.replay import plan_replay, run_replay
@@ -315,17 +358,21 @@ def fmu_runs(fmu_dir: str | Path, rec: OrcaflexRecord | None = None, path: str |
     acc_n, gyro_n = sensor_noise(rec)
     with tempfile.TemporaryDirectory() as tmp:
         mapping = Path(tmp) / "orcaflex.toml"
-        mapping.write_text(MAPPING, encoding="utf-8")
+        mapping.write_text(fix_mapping(), encoding="utf-8")
+        record = Path(tmp) / "orcaflex.csv"
+        _record_with_fixes(Path(path or data_file()), record)
         n = len(rec.acc)
         # one step past the last sample, so the estimators take it too (the recording then holds)
         step = 1.0 / RATE
-        plan = plan_replay(path or data_file(), mapping, "attitude,heave", step=step, duration=n * step)
+        plan = plan_replay(record, mapping, "attitude,heave,fusion", step=step, duration=n * step)
         from dataclasses import replace
 
         from ..cosim.ssp import Connection
 
         # the library's defaults and the record's noise, as in-process (not the system scenario's tuning)
-        own = {"att": {"acc_noise": acc_n, "gyro_noise": gyro_n, **FIXED_AIDING}, "heave": {"acc_noise": acc_n}}
+        q = tuple(f * acc_n ** 2 for f in RECEIVER_Q_FACTORS)
+        own = {"att": {"acc_noise": acc_n, "gyro_noise": gyro_n, **FIXED_AIDING}, "heave": {"acc_noise": acc_n},
+               "fusion": fusion_parameters(step, q, lag=step)}
         comps = tuple(replace(c, parameters=own[c.name]) if c.name in own else c for c in plan.system.components)
         plan = replace(plan, system=replace(plan.system, components=comps))
         heave = next(c for c in plan.system.components if c.name == "heave")
@@ -343,7 +390,10 @@ def fmu_runs(fmu_dir: str | Path, rec: OrcaflexRecord | None = None, path: str |
         heave=col("heave.heave")[after], heave_valid=np.asarray(res["heave.valid"], dtype=bool)[after],
         heave_band=col("heave_band.heave")[after] if band else np.full(n, np.nan),
         heave_band_valid=np.asarray(res["heave_band.valid"], dtype=bool)[after] if band else np.zeros(n, bool),
+        pos=np.column_stack([col(f"fusion.pos.{a}")[after] for a in "ned"]),
+        fusion_euler=np.column_stack([col("att.roll")[played], col("att.pitch")[played], col("rec.heading")[played]]),
         acc=np.column_stack([col(f"rec.imu.acc.{a}")[played] for a in "xyz"]),
+        gyro=np.column_stack([col(f"rec.imu.gyro.{a}")[played] for a in "xyz"]),
         gnss=np.column_stack([col(f"rec.gnss.ant1.{a}")[played] for a in "ned"]),
         heading=col("rec.heading")[played],
     )
@@ -386,11 +436,11 @@ def compare_orcaflex(rec: OrcaflexRecord | None = None, fmu_dir: str | Path | No
     roll, pitch = att["marinefmu AttitudeEstimator"].T
     out["marinefmu HeaveObserver"] = heave_scores(rec, roll, pitch)                 # the default, model = "wiener"
     out["marinefmu HeaveObserver (band)"] = heave_scores(rec, roll, pitch, model="band")
-    f_n = rotate_to_ned(rec.acc, roll, pitch, rec.heading)
     fix = np.arange(len(rec.acc)) % FIX_EVERY == 0
     fix[:k0] = False
     q = tuple(f * sensor_noise(rec)[0] ** 2 for f in RECEIVER_Q_FACTORS)
-    for name, pos in (("marinefmu fusion (one receiver)", receiver_fusion(f_n, rec.gnss, rec.dt, q)),
+    ours = receiver_fusion(rec.acc, np.c_[roll, pitch, rec.heading], rec.gnss, rec.dt, q)
+    for name, pos in (("marinefmu fusion (one receiver)", ours),
                       ("smsfusion AidedINS", aided_ins_run(rec)), ("raw GNSS", None)):
         e = 100.0 * (_rms(rec.gnss[fix] - rec.pos[fix]) if pos is None else _rms(pos[k0:] - rec.pos[k0:]))
         out[name] = {f"pos_{a}_cm": float(e[i]) for i, a in enumerate("ned")}
@@ -408,11 +458,9 @@ def _compare_fmu(rec: OrcaflexRecord, fmu_dir: str | Path) -> dict[str, dict[str
         out[name] = {"roll_deg": float(e[0]), "pitch_deg": float(e[1])}
     out["marinefmu HeaveObserver"] = heave_score(rec, runs.heave, runs.heave_valid)
     out["marinefmu HeaveObserver (band)"] = heave_score(rec, runs.heave_band, runs.heave_band_valid)
-    f_n = rotate_to_ned(runs.acc, runs.roll, runs.pitch, runs.heading)
     fix = np.arange(len(rec.acc)) % FIX_EVERY == 0
     fix[:k0] = False
-    q = tuple(f * sensor_noise(rec)[0] ** 2 for f in RECEIVER_Q_FACTORS)
-    for name, pos in (("marinefmu fusion (one receiver)", receiver_fusion(f_n, runs.gnss, rec.dt, q)),
+    for name, pos in (("marinefmu fusion (one receiver)", runs.pos),
                       ("smsfusion AidedINS", aided_ins_run(rec)), ("raw GNSS", None)):
         e = 100.0 * (_rms(rec.gnss[fix] - rec.pos[fix]) if pos is None else _rms(pos[k0:] - rec.pos[k0:]))
         out[name] = {f"pos_{a}_cm": float(e[i]) for i, a in enumerate("ned")}
@@ -450,12 +498,12 @@ def tune_receiver_q(duration: float = 600.0, factors: tuple[float, ...] = (1.0, 
     gnss = truth + rng.normal(0.0, RECEIVER_SIGMA, truth.shape)
     heading = rec["truth.yaw"] + rng.normal(0.0, COMPASS_SIGMA, len(truth))
     att = estimate_attitude(gyro, acc, dt, AttitudeEstimatorParams(acc_noise=acc_noise, gyro_noise=gyro_noise, **FIXED_AIDING))
-    f_n = rotate_to_ned(acc, att["roll"], att["pitch"], heading)
+    euler = np.c_[att["roll"], att["pitch"], heading]
     k0 = int(round(60.0 / dt))
     grid = [f * acc_noise ** 2 for f in factors]
     scores = []
     for q in grid:
-        e = _rms(receiver_fusion(f_n, gnss, dt, (q, q))[k0:] - truth[k0:])
+        e = _rms(receiver_fusion(acc, euler, gnss, dt, (q, q))[k0:] - truth[k0:])
         scores.append((float(np.mean(e[:2])), float(e[2])))
     scores_arr = np.array(scores)
     return factors[int(np.argmin(scores_arr[:, 0]))], factors[int(np.argmin(scores_arr[:, 1]))]

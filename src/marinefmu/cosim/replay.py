@@ -8,6 +8,14 @@ their lever arms are the record's: the IMU's (``--imu`` or the mapping's ``[imu]
 the antennas' (the mapping's), and the monitoring point's (``--point`` or the mapping's
 ``[ref] point.lever_arm``), all relative to the COG in the body frame.
 
+The fusion (GnssAccFusion) runs on four antennas as in that scenario. On a record with fewer
+(one receiver) it takes ``attitude = "input"``: the AttitudeEstimator's roll and pitch (brought
+along if not chosen) and the record's compass ``heading`` as the yaw rotate the specific force,
+and it reads ``gnss.ant1`` only, at the mapping's ``gnss.ant1`` lever arm or, without one, at
+the IMU. The yaw is the compass, a sensor as the vessel would have it, not ``ref.yaw``, which is
+the reference the report scores against; a one-receiver record without a ``[heading]`` is
+refused before the run.
+
 The base step is the record's mean sample interval (rounded to 9 significant digits) unless
 given, and the run lasts the record (less ``start``) unless given; a run longer than the record
 is reported before it starts (and the FMU logs the end of the record when it comes).
@@ -126,13 +134,21 @@ def plan_replay(record: str | Path, mapping: str | Path, estimators: str | list[
     imu_arm = imu_arm or m.lever_arms.get("imu")
     point_arm = point_arm or m.lever_arms.get("ref.point")
     comps = [ESTIMATORS[e][0] for e in names]
-    if any(c in comps for c in ("recon", "cr", "heave")) and "att" not in comps:
+    antennas = m.antennas()
+    # fewer than four antennas: one receiver, the attitude from the AttitudeEstimator and the compass
+    one_receiver = "fusion" in comps and 0 < len(antennas) < 4
+    if (one_receiver or any(c in comps for c in ("recon", "cr", "heave"))) and "att" not in comps:
         comps.insert(0, "att")
         notes.append("the AttitudeEstimator was added: it gives the roll and pitch the other estimators need")
-    if "fusion" in comps and len(m.antennas()) < 4:
-        raise MarineFmuError(f"--estimators fusion: GnssAccFusion needs four GNSS antennas with their lever arms; the "
-                             f"mapping {m.source} has {len(m.antennas())}")
-    if "fusion" in comps and any(f"gnss.ant{k}" not in m.lever_arms for k in m.antennas()):
+    if one_receiver and 1 not in antennas:
+        raise MarineFmuError(f"--estimators fusion: with fewer than four antennas GnssAccFusion reads gnss.ant1 (one "
+                             f"receiver); the mapping {m.source} maps {', '.join(f'ant{k}' for k in antennas)}")
+    if one_receiver and "heading" not in m.channels:
+        raise MarineFmuError(f"--estimators fusion: GnssAccFusion needs four GNSS antennas, or one receiver and a compass "
+                             f"heading for its yaw; the mapping {m.source} has {len(antennas)} antenna(s) and no [heading]")
+    if one_receiver and len(antennas) > 1:
+        notes.append(f"fusion: {len(antennas)} antennas, not four: one receiver, gnss.ant1, is used")
+    if "fusion" in comps and not one_receiver and any(f"gnss.ant{k}" not in m.lever_arms for k in antennas):
         raise MarineFmuError(f"--estimators fusion: the mapping {m.source} must state every antenna's lever_arm")
     needs = {"att": ("imu.acc", "imu.gyro"), "recon": ("imu.acc",), "fusion": ("imu.acc", "gnss"),
              "cr": ("imu.acc", "imu.gyro"), "heave": ("imu.acc",)}
@@ -140,6 +156,8 @@ def plan_replay(record: str | Path, mapping: str | Path, estimators: str | list[
         missing = [g for g in needs[c] if g not in m.channels]
         if missing:
             raise MarineFmuError(f"{c}: needs {', '.join(missing)} in the record; the mapping {m.source} has none")
+    if step is None:
+        step = float(f"{s.duration / max(1, s.rows - 1):.9g}")
     sc = load_scenario("system")
     by_name = {c.name: c for c in sc.system.components}
     arm = lambda prefix, v: {f"{prefix}.{a}": float(x) for a, x in zip("xyz", v)}  # noqa: E731
@@ -154,8 +172,15 @@ def plan_replay(record: str | Path, mapping: str | Path, estimators: str | list[
             p.update({"recon": arm("lever_arm", (0, 0, 0)), "fusion": arm("acc_lever_arm", (0, 0, 0)),
                       "cr": arm("sensor", (0, 0, 0))}[c])
             notes.append(f"{c}: no IMU lever arm in the mapping or --imu: the IMU is taken at the COG")
-        if c == "fusion":
-            for k in m.antennas():
+        if c == "fusion" and one_receiver:
+            # the AttitudeEstimator's roll and pitch arrive one step late (Jacobi coupling)
+            p.update({"attitude": "input", "attitude_lag": float(step)})
+            receiver = m.lever_arms.get("gnss.ant1")
+            if receiver is None:
+                notes.append("fusion: no lever arm for gnss.ant1 in the mapping: the receiver is taken at the IMU")
+            p.update(arm("ant1", receiver or imu_arm or (0.0, 0.0, 0.0)))
+        elif c == "fusion":
+            for k in antennas:
                 p.update(arm(f"ant{k}", m.lever_arms[f"gnss.ant{k}"]))
         if c == "heave":
             if point_arm is not None:
@@ -176,10 +201,12 @@ def plan_replay(record: str | Path, mapping: str | Path, estimators: str | list[
     connections = []
     for con in sc.system.connections:
         start_c = REC if con.start == "vessel" else con.start
-        if start_c in names_set and con.end in names_set:
+        unused = one_receiver and con.end == "fusion" and con.end_var.startswith(("gnss.ant2", "gnss.ant3", "gnss.ant4"))
+        if start_c in names_set and con.end in names_set and not unused:
             connections.append(Connection(start_c, con.start_var, con.end, con.end_var, con.delay))
-    if step is None:
-        step = float(f"{s.duration / max(1, s.rows - 1):.9g}")
+    if one_receiver:
+        connections += [Connection("att", "roll", "fusion", "roll"), Connection("att", "pitch", "fusion", "pitch"),
+                        Connection(REC, "heading", "fusion", "yaw")]
     available = s.duration - start
     if duration is None:
         duration = available

@@ -17,6 +17,7 @@ from ..estimators.heave.band_bank import BAND_VARIANCES
 from ..estimators.heave.common import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
 from ..estimators.heave.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
 from ..estimators.gnss_fusion.antenna_attitude import ANTENNAS
+from ..estimators.gnss_fusion.filter import ATTITUDE_CHOICES as FUSION_ATTITUDE_CHOICES
 from ..estimators.gnss_fusion.filter import COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, GnssAccFusionParams
 from ..estimators.reconstruction.decomposition import TILT_CHOICES
 from ..estimators.reconstruction.sliding import DisplacementReconstructorParams
@@ -110,6 +111,8 @@ def sliding_params(values: dict[str, Any]) -> DisplacementReconstructorParams:
 
 _FU = GnssAccFusionParams()
 FUSION_PARAMETERS: list[Variable] = [
+    Variable("attitude", "string", _FU.attitude, "", f"Attitude source: one of {', '.join(FUSION_ATTITUDE_CHOICES)} (the four antennas, or the roll/pitch/yaw inputs with one receiver on gnss.ant1 at ant1)"),
+    real("attitude_lag", _FU.attitude_lag, "s", "With attitude = input: how long the roll and pitch inputs lag the accelerometer (one step for an estimator in the same co-simulation); turned forward with the gyro, [0, 1]"),
     *[v for i, arm in enumerate(_FU.antennas) for v in vec(f"ant{i + 1}", "xyz", arm, "m", f"GNSS antenna {i + 1} lever arm relative to the COG, body frame")],
     *vec("acc_lever_arm", "xyz", 0.0, "m", "Accelerometer position relative to the COG, body frame"),
     real("q", _FU.q, "m2/s3", "Acceleration process-noise density (paper 001 eq. 16), > 0"),
@@ -142,6 +145,9 @@ FUSION_INPUTS: list[Variable] = [
     *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force at the accelerometer, body frame"),
     *vec("gyro", "xyz", 0.0, "rad/s", "Angular rate, body frame (for propagation = gyro)"),
     *[v for i in range(ANTENNAS) for v in vec(f"gnss.ant{i + 1}", "ned", 0.0, "m", f"Measured position of GNSS antenna {i + 1}, NED")],
+    real("roll", 0.0, "rad", "Roll (ZYX Euler) for attitude = input"),
+    real("pitch", 0.0, "rad", "Pitch (ZYX Euler) for attitude = input"),
+    real("yaw", 0.0, "rad", "Yaw (ZYX Euler; a compass heading) for attitude = input"),
     Variable("gnss.valid", "boolean", False, "", "True when the antenna positions hold a valid fix"),
     Variable("gnss.new", "boolean", False, "", "True on the step a new fix arrived (if unconnected, a change of the positions marks a new fix)"),
 ]
@@ -149,9 +155,9 @@ FUSION_OUTPUTS: list[Variable] = [
     *vec("pos", "ned", 0.0, "m", "Fused COG position, NED"),
     *vec("vel", "ned", 0.0, "m/s", "Fused COG velocity, NED"),
     *vec("pos_std", "ned", 0.0, "m", "Standard deviation of the fused position (the error covariance of the filter as run, with the sensor noises and the attitude error; in a gap the wave coast's own plus the output's spread about it), NED"),
-    real("roll", 0.0, "rad", "Roll used for the correction (antennas, gyro-propagated)"),
-    real("pitch", 0.0, "rad", "Pitch used for the correction"),
-    real("yaw", 0.0, "rad", "Yaw used for the correction"),
+    real("roll_used", 0.0, "rad", "Roll used for the correction (antennas, gyro-propagated; or the input)"),
+    real("pitch_used", 0.0, "rad", "Pitch used for the correction"),
+    real("yaw_used", 0.0, "rad", "Yaw used for the correction"),
     *vec("acc_n", "ned", 0.0, "m/s2", "Attitude-corrected acceleration at the accelerometer, NED"),
     *vec("acc_bias", "ned", 0.0, "m/s2", "Estimated accelerometer bias, NED"),
     real("gnss.residual", 0.0, "m", "RMS antenna-fit residual of the latest fix"),
@@ -168,7 +174,7 @@ def fusion_params(values: dict[str, Any]) -> GnssAccFusionParams:
     xyz = lambda prefix: tuple(v[f"{prefix}.{a}"] for a in "xyz")  # noqa: E731
     return GnssAccFusionParams(
         antennas=tuple(xyz(f"ant{i + 1}") for i in range(ANTENNAS)), acc_lever_arm=xyz("acc_lever_arm"),
-        q=v["q"], q_down=v["q_down"] or None, r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
+        attitude=v["attitude"], attitude_lag=v["attitude_lag"], q=v["q"], q_down=v["q_down"] or None, r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
         coast=v["coast"], coast_sigma=v["coast_sigma"], coast_attitude_tau=v["coast_attitude_tau"],
@@ -212,7 +218,7 @@ CR_OUTPUTS: list[Variable] = [
     real("delay", 0.0, "s", "Lag of all outputs behind the inputs (half the differentiation window)"),
 ]
 CR_BOOLEANS: list[Variable] = [
-    Variable("valid", "boolean", False, "", "Differentiation window full and the sample good"),
+    Variable("valid", "boolean", False, "", "Differentiation window full, the sample good, and rotation enough to observe the offset by (not in harbour)"),
     Variable("settled", "boolean", False, "", "settle_time has passed: offset_mean is an average"),
 ]
 

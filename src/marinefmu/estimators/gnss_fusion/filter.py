@@ -76,12 +76,28 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
    gap in the coast's first 3 minutes) the filter holds its position (velocity zero) until
    GNSS returns. The accuracy through dropouts is measured by ``make bench``, part
    ``dropout`` (the benchmarks page).
+5. **One receiver and an external attitude** (``attitude="input"``, beyond the paper): for a
+   vessel with one GNSS receiver and an attitude from elsewhere (an
+   :class:`~marinefmu.estimators.attitude.estimator.AttitudeEstimator`'s roll and pitch, a
+   compass's heading). Each step's roll, pitch, yaw rotate the specific force into NED
+   (f_n = R_nb f_b) and move the receiver's fix of antenna 1 to the accelerometer point
+   (p_acc = p_ant1 + R_nb (l_acc − l_ant1)); the filter then runs as above on that point with
+   ``attitude_correction=False`` and ``propagation="hold"``, each fix handed to it as a rigid
+   antenna set at identity attitude around the point (:func:`receiver_params`), so the
+   antenna solution returns exactly the fix and the Kalman filter, gating, bias states, coast
+   and re-initialisation are the same code as the four antennas'. The outputs are moved from
+   the accelerometer point to the COG with the same angles. Roll and pitch that lag the
+   accelerometer (an estimator in the same co-simulation delivers them one step late) are
+   turned forward over ``attitude_lag`` with the gyro. A non-finite or implausible angle
+   (:func:`~marinefmu.estimators.samples.angles_beyond_limit`) is a bad sample: the step
+   coasts on the last good NED specific force, and a fix in it is placed with the last good
+   angles.
 """
 from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -89,8 +105,8 @@ from filterpy.kalman import KalmanFilter
 from scipy.spatial.transform import Rotation
 
 from ...errors import ParameterError, check_choice, check_range, check_vector
-from ...frames import GRAVITY_N, cross3, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
-from ..samples import force_beyond_limit, rate_beyond_limit
+from ...frames import GRAVITY_N, cross3, euler_to_quat, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
+from ..samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
 from .antenna_attitude import ANTENNAS, DEFAULT_ANTENNAS, MIN_SPREAD, AntennaFix, antenna_attitude, antenna_attitude_std
 from .error_model import FusionError, pi_gains
 from .wave_coast import WaveCoast
@@ -100,6 +116,11 @@ log = logging.getLogger(__name__)
 PROPAGATION_CHOICES = ("gyro", "hold")
 STEP_INPUT_CHOICES = ("mean", "latest")
 COAST_CHOICES = ("band", "inertial")
+ATTITUDE_CHOICES = ("antennas", "input")
+#: The rigid antenna set at identity attitude that carries one receiver's fix through the antenna
+#: solution (``attitude="input"``, module docstring item 5): the default antennas about their
+#: centroid, body frame [m].
+RECEIVER_ANTENNAS = tuple(tuple(float(x) for x in a) for a in (np.array(DEFAULT_ANTENNAS) - np.mean(DEFAULT_ANTENNAS, axis=0)))
 #: With ``coast="band"``, pseudo-fixes start this long [s] after the last accepted fix ...
 COAST_AFTER = 2.0
 #: ... and follow each other at this interval [s]: often enough that the fused output follows
@@ -125,9 +146,26 @@ class GnssAccFusionParams:
     ----------
     antennas : tuple
         Four antenna lever arms relative to the COG, body frame [m]; distinct, spanning a
-        plane. [``ant{1..4}.{x,y,z}``]
+        plane. With ``attitude="input"`` only the first is read: the receiver's antenna.
+        [``ant{1..4}.{x,y,z}``]
     acc_lever_arm : tuple of float
         Accelerometer position relative to the COG, body frame [m]. [``acc_lever_arm.*``]
+    attitude : {"antennas", "input"}
+        Where the attitude comes from: the four antennas (the paper), or the roll, pitch, yaw
+        given to :meth:`GnssAccFusion.step` with one receiver on antenna 1 (module docstring,
+        item 5; ``attitude_correction``, ``propagation``, ``attitude_tau``,
+        ``coast_attitude_tau``, ``coast_tilt``, ``coast_tilt_band``, ``max_residual`` and
+        antennas 2-4 then have no effect, and ``antenna_sigma_h``, ``antenna_sigma_v`` are the
+        receiver's noise, at most 50 m). [``attitude``]
+    attitude_lag : float
+        With ``attitude="input"``: how long the roll and pitch inputs lag the accelerometer
+        sample they come with [s], [0, 1]. They are turned forward over it with the gyro (the
+        rate over the step, ``step_input``); the yaw input is taken as it is (a compass). An
+        attitude estimator in the same co-simulation delivers its roll and pitch one
+        communication step late (Jacobi coupling): set the step, as ``marinefmu replay`` does.
+        Left unturned, a lag τ tilts the specific force by the angular rate times τ, and g
+        times that tilt goes into the horizontal acceleration (docs/fmus/GnssAccFusion.md has
+        what it costs on a record). [``attitude_lag``]
     q : float
         Acceleration process-noise density of eq. 16 [m²/s³], > 0. [``q``]
     q_down : float or None
@@ -253,19 +291,23 @@ class GnssAccFusionParams:
     antenna_sigma_v: float = 0.015
     acc_noise: float = 7e-4
     gyro_noise: float = 5e-5
+    attitude: str = "antennas"
+    attitude_lag: float = 0.0
     arms: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        check_choice("attitude", self.attitude, ATTITUDE_CHOICES)
         if len(self.antennas) != ANTENNAS:
             raise ParameterError(f"antennas: expected {ANTENNAS} lever arms ant1..ant4, got {len(self.antennas)}")
         arms = np.array([check_vector(f"ant{i + 1}.{{x,y,z}}", a, unit="m") for i, a in enumerate(self.antennas)])
-        for i in range(ANTENNAS):
-            for j in range(i + 1, ANTENNAS):
-                if np.linalg.norm(arms[i] - arms[j]) < 0.1:
-                    raise ParameterError(f"ant{i + 1} and ant{j + 1} are closer than 0.1 m: antennas must be distinct")
-        if np.linalg.svd(arms - arms.mean(axis=0), compute_uv=False)[1] < MIN_SPREAD * 2:
-            raise ParameterError("ant1..ant4 are collinear: the antennas must span a plane (second singular value >= 0.1 m)")
         object.__setattr__(self, "arms", arms)
+        if self.attitude == "antennas":     # with one receiver (attitude="input") only ant1 is read
+            for i in range(ANTENNAS):
+                for j in range(i + 1, ANTENNAS):
+                    if np.linalg.norm(arms[i] - arms[j]) < 0.1:
+                        raise ParameterError(f"ant{i + 1} and ant{j + 1} are closer than 0.1 m: antennas must be distinct")
+            if np.linalg.svd(arms - arms.mean(axis=0), compute_uv=False)[1] < MIN_SPREAD * 2:
+                raise ParameterError("ant1..ant4 are collinear: the antennas must span a plane (second singular value >= 0.1 m)")
         check_vector("acc_lever_arm", self.acc_lever_arm, unit="m")
         check_range("q", self.q, lo=0.0, lo_open=True, hi=1e6, unit="m2/s3")
         if self.q_down is not None:
@@ -274,6 +316,7 @@ class GnssAccFusionParams:
         check_choice("propagation", self.propagation, PROPAGATION_CHOICES)
         check_choice("step_input", self.step_input, STEP_INPUT_CHOICES)
         check_range("attitude_tau", self.attitude_tau, lo=0.1, hi=1000.0, unit="s")
+        check_range("attitude_lag", self.attitude_lag, lo=0.0, hi=1.0, unit="s")
         if self.gate != math.inf:  # inf: no gating (the paper)
             check_range("gate", self.gate, lo=0.0, lo_open=True, unit="sigma")
         check_range("bias_rw", self.bias_rw, lo=0.0, lo_open=True, hi=10.0, unit="m/s2/sqrt(s)")
@@ -286,8 +329,10 @@ class GnssAccFusionParams:
         check_range("coast_window", self.coast_window, lo=10.0, hi=3600.0, unit="s")
         check_range("gyro_bias_sigma", self.gyro_bias_sigma, lo=0.0, lo_open=True, hi=1.0, unit="rad/s")
         check_range("gyro_bias_tau", self.gyro_bias_tau, lo=0.1, hi=1e6, unit="s")
-        check_range("antenna_sigma_h", self.antenna_sigma_h, lo=0.0, lo_open=True, hi=100.0, unit="m")
-        check_range("antenna_sigma_v", self.antenna_sigma_v, lo=0.0, lo_open=True, hi=100.0, unit="m")
+        # one receiver: its noise is doubled on the virtual antenna set (receiver_params)
+        sigma_max = 100.0 if self.attitude == "antennas" else 50.0
+        check_range("antenna_sigma_h", self.antenna_sigma_h, lo=0.0, lo_open=True, hi=sigma_max, unit="m")
+        check_range("antenna_sigma_v", self.antenna_sigma_v, lo=0.0, lo_open=True, hi=sigma_max, unit="m")
         check_range("acc_noise", self.acc_noise, lo=0.0, lo_open=True, hi=10.0, unit="m/s2/sqrt(Hz)")
         check_range("gyro_noise", self.gyro_noise, lo=0.0, lo_open=True, hi=1.0, unit="rad/s/sqrt(Hz)")
 
@@ -400,6 +445,22 @@ def process_noise(dt: float, q: float, bias_rw: float | None, q_down: float | No
     return out
 
 
+def receiver_params(params: GnssAccFusionParams) -> GnssAccFusionParams:
+    """The parameters the filter runs with for ``attitude="input"`` (module docstring, item 5).
+
+    The specific force arrives in NED and the fix at the accelerometer point, so there is no
+    correction (``attitude_correction=False``, a_n = f_n + g_n), no lever arm and a held
+    identity attitude (``propagation="hold"``); the fix is the rigid set
+    :data:`RECEIVER_ANTENNAS` about the point. Its four antennas carry the receiver's one
+    error, so their noise is twice the receiver's: the centroid of four independent antennas
+    would have σ/2 (:mod:`.error_model`). The rigid set has no attitude error, so the fix
+    attitude's share of ``pos_std`` is nil.
+    """
+    return replace(params, attitude="antennas", attitude_correction=False, propagation="hold",
+                   acc_lever_arm=(0.0, 0.0, 0.0), antennas=RECEIVER_ANTENNAS,
+                   antenna_sigma_h=2.0 * params.antenna_sigma_h, antenna_sigma_v=2.0 * params.antenna_sigma_v)
+
+
 class GnssAccFusion:
     """Attitude-corrected GNSS + accelerometer Kalman fusion (paper 001), one sample per step.
 
@@ -419,11 +480,15 @@ class GnssAccFusion:
 
     def __init__(self, params: GnssAccFusionParams | None = None) -> None:
         self.params = params or GnssAccFusionParams()
+        #: The parameters the filter runs with: :attr:`params`, or for ``attitude="input"``
+        #: their one-receiver form (:func:`receiver_params`).
+        self.run_params = self.params if self.params.attitude == "antennas" else receiver_params(self.params)
         self.reset()
 
     def reset(self) -> None:
         """Forget everything: the next good GNSS fix initialises the filter."""
-        p = self.params
+        p = self.run_params
+        self.angles: np.ndarray | None = None  # the last good roll, pitch, yaw input (attitude="input")
         nx = 9 if p.bias_states else 6
         self.kf = KalmanFilter(dim_x=nx, dim_z=3)
         self.kf.H = np.hstack((np.eye(3), np.zeros((3, nx - 3))))
@@ -459,7 +524,8 @@ class GnssAccFusion:
                                  p.attitude_correction)
 
     # ---- per step ----------------------------------------------------------------------------
-    def step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None) -> GnssAccFusionResult:
+    def step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None,
+             euler: Any | None = None) -> GnssAccFusionResult:
         """Advance by one accelerometer sample.
 
         Parameters
@@ -468,18 +534,87 @@ class GnssAccFusion:
             (3,) specific force at the accelerometer, body frame [m/s²].
         gnss : array_like or None
             (4, 3) or (12,) antenna positions of a GNSS epoch that arrived this step, NED [m];
-            None when there is no new epoch.
+            with ``attitude="input"`` (3,) the receiver's position (antenna 1; of a (4, 3) or
+            (12,) array the first antenna is read). None when there is no new epoch.
         dt : float
             Step [s] since the previous sample.
         gyro : array_like, optional
-            (3,) angular rate, body frame [rad/s] (``propagation="gyro"``; with ``"hold"`` the coast through a gap).
+            (3,) angular rate, body frame [rad/s] (``propagation="gyro"``; with ``"hold"`` the
+            coast through a gap; with ``attitude="input"`` the COG velocity's lever-arm term).
+        euler : array_like, optional
+            (3,) roll, pitch, yaw [rad] (ZYX) with ``attitude="input"``; ignored otherwise.
+            None, non-finite or beyond the limits of
+            :func:`~marinefmu.estimators.samples.angles_beyond_limit`: a bad sample.
         """
+        if self.params.attitude == "antennas":
+            return self._step(acc, gnss, dt, gyro)
+        f_n, fix, bad = self._receiver_inputs(acc, gnss, euler, gyro)
+        return self._receiver_output(self._step(f_n, fix, dt, gyro, bad))
+
+    def _receiver_inputs(self, acc: Any, gnss: Any | None, euler: Any | None,
+                         gyro: Any | None) -> tuple[Any, np.ndarray | None, str | None]:
+        """``attitude="input"``: the specific force rotated into NED by the input angles (roll
+        and pitch turned forward over ``attitude_lag``), the fix moved to the accelerometer
+        point as the rigid set of :func:`receiver_params`, and the reason if the angles are bad
+        (the fix is then placed with the last good ones, and dropped before any)."""
+        ang = np.full(3, math.nan) if euler is None else np.asarray(euler, dtype=float).reshape(3)
+        if not np.all(np.isfinite(ang)):
+            bad = "bad roll, pitch or yaw input (NaN/Inf)"
+        else:
+            bad = (why := angles_beyond_limit(ang)) and f"bad angle input: {why}"
+        if bad is None:
+            w = self._lag_rate(gyro)
+            if w is not None:   # the roll and pitch of attitude_lag ago, turned to now; the yaw as given
+                roll, pitch, _ = quat_to_euler(propagate(euler_to_quat(*ang), w, self.params.attitude_lag))
+                ang = np.array([roll, pitch, ang[2]])
+            self.angles = ang
+        else:
+            bad += ": coasting on the last good specific force"
+        rot = None if self.angles is None else rot_nb(*self.angles)
+        f_n = acc if bad is not None else rot @ np.asarray(acc, dtype=float).reshape(3)
+        if gnss is None or rot is None:
+            return f_n, None, bad
         p = self.params
+        point = np.asarray(gnss, dtype=float).reshape(-1, 3)[0] + rot @ (np.asarray(p.acc_lever_arm) - p.arms[0])
+        return f_n, point + self.run_params.arms, bad
+
+    def _lag_rate(self, gyro: Any | None) -> np.ndarray | None:
+        """The body rate [rad/s] over this step that turns the input attitude over
+        ``attitude_lag`` (as the filter takes it: ``step_input``), or None without a lag or a
+        good gyro sample."""
+        if self.params.attitude_lag == 0.0 or gyro is None:
+            return None
+        w = np.asarray(gyro, dtype=float).reshape(3)
+        if not (np.all(np.isfinite(w)) and rate_beyond_limit(w) is None):
+            w = self.last_gyro     # a bad sample: the step's warning comes from the filter
+        if w is None or self.params.step_input == "latest" or self.last_gyro is None:
+            return w
+        return 0.5 * (self.last_gyro + w)
+
+    def _receiver_output(self, r: GnssAccFusionResult) -> GnssAccFusionResult:
+        """``attitude="input"``: the accelerometer point's estimate moved to the COG with the
+        last good input angles, which are the ``euler`` output."""
+        if self.angles is None:
+            return r
+        rot = rot_nb(*self.angles)
+        arm = np.asarray(self.params.acc_lever_arm)
+        pos, vel = np.array(r.pos), np.array(r.vel)
+        if self.initialised:
+            pos -= rot @ arm
+            if self.last_gyro is not None:
+                vel -= rot @ cross3(self.last_gyro, arm)
+        return replace(r, pos=tuple(pos.tolist()), vel=tuple(vel.tolist()), euler=tuple(self.angles.tolist()))
+
+    def _step(self, acc: Any, gnss: Any | None, dt: float, gyro: Any | None = None,
+              bad: str | None = None) -> GnssAccFusionResult:
+        """:meth:`step` with :attr:`run_params`; ``bad``: the reason this step's specific force
+        is not to be used (it coasts on the last good one, as on a bad sample)."""
+        p = self.run_params
         warning = None
         f_b = np.asarray(acc, dtype=float).reshape(3)
-        good = bool(np.all(np.isfinite(f_b))) and force_beyond_limit(f_b) is None
+        good = bad is None and bool(np.all(np.isfinite(f_b))) and force_beyond_limit(f_b) is None
         if not good:
-            warning = "bad accelerometer sample (NaN/Inf/absurd): coasting on the last good one"
+            warning = bad or "bad accelerometer sample (NaN/Inf/absurd): coasting on the last good one"
             f_b = self.last_acc
         self.last_acc = f_b
         w = None if gyro is None else np.asarray(gyro, dtype=float).reshape(3)
@@ -538,7 +673,7 @@ class GnssAccFusion:
         return self._result(fix, valid, warning, w)
 
     def _epoch(self, gnss: Any, dt: float) -> tuple[str, str | None]:
-        p = self.params
+        p = self.run_params
         gap, self.since_epoch = self.since_epoch, 0.0
         sol = antenna_attitude(np.asarray(gnss, dtype=float), p.arms)
         if isinstance(sol, str):
@@ -624,13 +759,13 @@ class GnssAccFusion:
         an attitude that the vessel has left, and the output is not valid. The wave coast
         still bounds the drift (metres through a 30 s dropout, against hundreds of metres
         without the coast), but neither it nor ``pos_std`` knows the attitude's error then."""
-        return (self.params.propagation == "hold" and not self._coast_gyro()
+        return (self.run_params.propagation == "hold" and not self._coast_gyro()
                 and self.since_fix > HOLD_OVERDUE * self.fix_interval)
 
     def _holding(self) -> bool:
         """No accepted fix and no pseudo-fix for ``max_coast`` s: the position is held (an
         inertial coast is kilometres off after minutes, and ``valid`` is false by then)."""
-        p = self.params
+        p = self.run_params
         return self.since_fix > p.max_coast and self.since_pseudo > p.max_coast
 
     def _pseudo_fix(self, dt: float) -> bool:
@@ -648,7 +783,7 @@ class GnssAccFusion:
         # how far the filter strays from the coast between pseudo-fixes (pos_std in a gap)
         y2 = (z - self.kf.H @ self.kf.x.ravel()) ** 2
         self.coast_track = y2 if self.coast_track is None else self.coast_track + TRACK_WEIGHT * (y2 - self.coast_track)
-        self.kf.update(z, R=np.diag(self.params.coast_sigma ** 2 + self.coast_var))
+        self.kf.update(z, R=np.diag(self.run_params.coast_sigma ** 2 + self.coast_var))
         self.error.follow(self.kf.P)
         self.since_pseudo = 0.0
         return True
@@ -656,7 +791,7 @@ class GnssAccFusion:
     def _initialise(self, sol: AntennaFix, z: np.ndarray, r_meas: np.ndarray, keep_velocity: bool = False) -> None:
         """Start the filter on a fix: position ``z``, velocity 0 ± 1 m/s or (``keep_velocity``)
         the coasted one with its variance plus the wave coast's, bias 0 ± 0.01 m/s²."""
-        p = self.params
+        p = self.run_params
         nx = self.kf.dim_x
         var = np.array([r_meas[0, 0]] * 3 + [1.0] * 3 + ([1e-4] * 3 if p.bias_states else []))
         x = np.zeros((nx, 1))
@@ -689,7 +824,7 @@ class GnssAccFusion:
         arm) to the output whole. The cap lowers the error in the first half minute after a
         gap and changes nothing before it (docs/decisions/gnss-fusion-filter.md).
         """
-        p = self.params
+        p = self.run_params
         if p.propagation == "hold":
             if dt_fix <= HOLD_OVERDUE * self.fix_interval:     # held since the last fix (not the gyro's)
                 self.error.held_rotation(Rotation.from_matrix(rot_fix @ quat_to_rot(self.q).T).as_rotvec(), dt_fix, fix_std)
@@ -700,7 +835,7 @@ class GnssAccFusion:
         self.error.attitude_fix(fix_std, dt_fix, alpha)
 
     def _result(self, fix: str, valid: bool, warning: str | None, w: np.ndarray | None) -> GnssAccFusionResult:
-        p = self.params
+        p = self.run_params
         rot = quat_to_rot(self.q)
         x = self.kf.x.ravel()
         arm = rot @ np.asarray(p.acc_lever_arm)
@@ -733,6 +868,7 @@ class GnssAccFusion:
             "coast_track": None if self.coast_track is None else self.coast_track.tolist(),
             "coaster": None if self.coaster is None else self.coaster.get_state(),
             "error": self.error.get_state(),
+            "angles": None if self.angles is None else self.angles.tolist(),
         }
 
     def set_state(self, s: dict) -> None:
@@ -753,3 +889,4 @@ class GnssAccFusion:
         if self.coaster is not None:
             self.coaster.set_state(s["coaster"])
         self.error.set_state(s["error"])
+        self.angles = None if s.get("angles") is None else np.array(s["angles"])

@@ -16,8 +16,8 @@ from .filter import GnssAccFusionParams, GnssAccFusion, transition
 
 
 def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyro: np.ndarray | None = None,
-         params: GnssAccFusionParams | None = None, smooth: bool = False, gnss_valid: np.ndarray | None = None
-         ) -> dict[str, np.ndarray]:
+         params: GnssAccFusionParams | None = None, smooth: bool = False, gnss_valid: np.ndarray | None = None,
+         euler: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Run :class:`~.filter.GnssAccFusion` over whole records, optionally with the RTS smoother.
 
     Parameters
@@ -27,7 +27,8 @@ def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyr
     dt : float
         Sample interval [s].
     gnss : numpy.ndarray
-        (N, 12) antenna positions (ant1 n, e, d, ant2, …) [m], read where ``gnss_new``.
+        (N, 12) antenna positions (ant1 n, e, d, ant2, …) [m], read where ``gnss_new``; with
+        ``attitude="input"`` (N, 3) the receiver's (antenna 1).
     gnss_new : numpy.ndarray
         (N,) bool, True at the samples where a new epoch arrived.
     gnss_valid : numpy.ndarray, optional
@@ -36,6 +37,8 @@ def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyr
     gyro : numpy.ndarray, optional
         (N, 3) angular rate [rad/s, b].
     params : GnssAccFusionParams, optional
+    euler : numpy.ndarray, optional
+        (N, 3) roll, pitch, yaw [rad] for ``attitude="input"`` (required then).
     smooth : bool
         Also return the RTS fixed-interval smoothed ``pos_smooth`` and ``vel_smooth``. Through
         a GNSS gap of up to ``max_coast`` s it does better than the real-time output (``make
@@ -51,9 +54,14 @@ def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyr
     """
     acc = np.asarray(acc, dtype=float)
     n = len(acc)
-    if acc.shape != (n, 3) or np.shape(gnss) != (n, 12) or np.shape(gnss_new) != (n,):
-        raise ShapeError(f"expected acc (N, 3), gnss (N, 12), gnss_new (N,); got {acc.shape}, {np.shape(gnss)}, {np.shape(gnss_new)}")
     est = GnssAccFusion(params)
+    one = est.params.attitude == "input"
+    width = 3 if one else 12
+    if acc.shape != (n, 3) or np.shape(gnss) != (n, width) or np.shape(gnss_new) != (n,):
+        raise ShapeError(f"expected acc (N, 3), gnss (N, {width}), gnss_new (N,); got {acc.shape}, {np.shape(gnss)}, "
+                         f"{np.shape(gnss_new)}")
+    if one and np.shape(euler) != (n, 3):
+        raise ShapeError(f"attitude = 'input': expected euler (N, 3) roll, pitch, yaw; got {np.shape(euler)}")
     out = {k: np.empty((n, 3)) for k in ("pos", "vel", "pos_std", "euler", "acc_n", "acc_bias")}
     out["valid"] = np.empty(n, dtype=bool)
     out["fix"] = np.empty(n, dtype=object)
@@ -65,7 +73,8 @@ def fuse(acc: np.ndarray, dt: float, gnss: np.ndarray, gnss_new: np.ndarray, gyr
     arms = np.zeros((n, 3))
     use = np.asarray(gnss_new, dtype=bool) & (True if gnss_valid is None else np.asarray(gnss_valid, dtype=bool))
     for k in range(n):
-        r = est.step(acc[k], gnss[k] if use[k] else None, dt, None if gyro is None else gyro[k])
+        r = est.step(acc[k], gnss[k] if use[k] else None, dt, None if gyro is None else gyro[k],
+                     euler[k] if one else None)
         for key in ("pos", "vel", "pos_std", "euler", "acc_n", "acc_bias"):
             out[key][k] = getattr(r, key)
         out["valid"][k], out["fix"][k] = r.valid, r.fix
@@ -87,12 +96,11 @@ def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarr
 
     For a data set with a single antenna (and a compass) instead of four: ``f_n`` is the
     specific force already rotated into NED by an external attitude (eqs. 25-26 done
-    outside: f_n = R_nb f_b), ``pos`` the receiver's fixes of the accelerometer point.
-    :class:`~.filter.GnssAccFusion` runs with ``attitude_correction=False`` (a_n = f_n + g_n),
-    ``propagation="hold"`` and no lever arm, and each fix is handed to it as a rigid antenna
-    set at identity attitude around the fix (the antenna solution then returns exactly the
-    fix), so the Kalman filter, gating, bias states, coasting and re-initialisation are the
-    same code as the four-antenna estimator's.
+    outside: f_n = R_nb f_b), ``pos`` the receiver's fixes of the accelerometer point. This is
+    :class:`~.filter.GnssAccFusion` with ``attitude="input"`` (its module docstring, item 5)
+    at zero angles, with the receiver and the accelerometer at the COG: the Kalman filter,
+    gating, bias states, coasting and re-initialisation are the same code as the four-antenna
+    estimator's.
 
     Parameters
     ----------
@@ -105,9 +113,9 @@ def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarr
     pos_new : numpy.ndarray
         (N,) bool, True where a new fix arrived.
     params : GnssAccFusionParams, optional
-        ``q``, ``q_down``, ``r``, ``gate``, ``bias_states`` … (its antennas, lever arm,
-        attitude correction and propagation are overridden as above). ``antenna_sigma_h`` and
-        ``antenna_sigma_v`` are the receiver's noise, for ``pos_std``.
+        ``q``, ``q_down``, ``r``, ``gate``, ``bias_states`` … (its attitude, antenna 1 and lever
+        arm are overridden as above). ``antenna_sigma_h`` and ``antenna_sigma_v`` are the
+        receiver's noise, for ``pos_std``.
 
     Returns
     -------
@@ -115,16 +123,11 @@ def fuse_receiver(f_n: np.ndarray, dt: float, pos: np.ndarray, pos_new: np.ndarr
         As :func:`fuse`.
     """
     p = params or GnssAccFusionParams()
-    # centred virtual antennas: the attitude is exact and has no share in pos_std; they carry the
-    # receiver's one error, so the centroid's noise is the receiver's (error_model: σ²/4)
-    p = replace(p, attitude_correction=False, propagation="hold", acc_lever_arm=(0.0, 0.0, 0.0),
-                antennas=tuple(tuple(a) for a in (p.arms - p.arms.mean(axis=0)).tolist()),
-                antenna_sigma_h=2.0 * p.antenna_sigma_h, antenna_sigma_v=2.0 * p.antenna_sigma_v)
+    p = replace(p, attitude="input", acc_lever_arm=(0.0, 0.0, 0.0), antennas=((0.0, 0.0, 0.0), *p.antennas[1:]))
     pos = np.asarray(pos, dtype=float)
     if pos.ndim != 2 or pos.shape[1] != 3:
         raise ShapeError(f"expected pos (N, 3); got {pos.shape}")
-    virtual = np.hstack([pos + arm for arm in p.arms])
-    return fuse(f_n, dt, virtual, pos_new, None, p)
+    return fuse(f_n, dt, pos, pos_new, None, p, euler=np.zeros((len(pos), 3)))
 
 
 def orphan_steps(priors: list, accepted: np.ndarray) -> np.ndarray:
