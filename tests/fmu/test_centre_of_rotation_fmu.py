@@ -60,3 +60,37 @@ def test_cr_fmu_state_restore_repeats_the_run(fmu_dir, tmp_path, rec):
     assert again == first
     f.fmu.freeFMUstate(state)
     f.close()
+
+
+@pytest.mark.fmu
+def test_no_rotation_is_said_once_in_the_fmu_log(fmu_dir, tmp_path):
+    """A vessel in harbour (constant specific force, zero rate): the estimator's reason for
+    valid = false, which it gives through Python's logging, reaches the FMU log once, at the
+    step's time, and the step status stays OK."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+
+    logged = []
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(lambda env, inst, status, cat, text: logged.append((status, text.decode())))
+    path = fmu_dir / "CentreOfRotation.fmu"
+    md = read_model_description(str(path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(path), unzipdir=str(tmp_path / "u")),
+                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="harbour")
+    fmu.instantiate(loggingOn=True, callbacks=cb)
+    fmu.setDebugLogging(True, [])
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    fmu.setReal([vr[f"acc.{a}"] for a in "xyz"], [0.0, 0.0, -9.80665])
+    fmu.setReal([vr[f"gyro.{a}"] for a in "xyz"], [0.0, 0.0, 0.0])
+    for k in range(1000):
+        fmu.doStep(currentCommunicationPoint=k * DT, communicationStepSize=DT)
+    valid = fmu.getBoolean([vr["valid"]])[0]
+    fmu.terminate()
+    fmu.freeInstance()
+    said = [(s, m) for s, m in logged if "no rotation" in m]
+    assert not valid
+    assert len(said) == 1 and said[0][0] == 1, logged          # once, as a warning (fmi2Warning = 1)
+    assert said[0][1].startswith("harbour: t = ") and "valid = false" in said[0][1], said

@@ -24,6 +24,13 @@ made by their import when they run again (:meth:`SlaveIO.rerun`) instead of maki
 one, and :class:`SlaveIO` drops repeated ``sys.path`` entries. What remains (the MRO lists
 and class-name strings) is measured by ``marinefmu bench`` (the FMU contract page).
 
+**The estimators' own log.** What an estimator reports through :mod:`logging` while a slave
+steps it (a heave observer that finds no sea, a centre of rotation with no rotation to see,
+a bias step found) goes to that instance's FMU log as a warning, at the step's time: one
+handler on the ``marinefmu`` logger hands each record to the slave stepping on the thread that
+made it (libcosim may step instances on several threads). A bad-sample message the slave
+already reports through :meth:`SlaveIO.warn` is not repeated.
+
 **Process exit.** At ``exit()`` pythonfmu 0.7.0's library writes into memory its own static
 destructor has freed. Every :class:`SlaveIO` therefore arms :func:`marinefmu.fmu.host_exit.guard`
 for the library it runs in (once per loaded copy), which empties that pointer first, so any
@@ -32,8 +39,10 @@ host, Python or not, exits cleanly (``host_exit``'s module doc has the mechanism
 from __future__ import annotations
 
 import copy
+import logging
 import math
 import sys
+import threading
 import traceback
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
@@ -49,6 +58,23 @@ from . import host_exit
 M = TypeVar("M")
 _FMI_TYPES = {"real": Real, "integer": Integer, "boolean": Boolean, "string": String}
 _CAST: dict[str, Callable[[Any], Any]] = {"real": float, "integer": int, "boolean": bool, "string": str}
+
+
+#: The SlaveIO stepping on each thread (thread id → SlaveIO), for :class:`_ToFmuLog`.
+_STEPPING: dict[int, "SlaveIO"] = {}
+
+
+class _ToFmuLog(logging.Handler):
+    """Collects a ``marinefmu`` log record for the slave stepping on the record's thread."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        io = _STEPPING.get(record.thread)
+        if io is not None:
+            io._logged.append(record)
+
+
+if not any(isinstance(h, _ToFmuLog) for h in logging.getLogger("marinefmu").handlers):
+    logging.getLogger("marinefmu").addHandler(_ToFmuLog(logging.WARNING))
 
 
 def _describe(var: Variable) -> str:
@@ -97,6 +123,7 @@ class SlaveIO:
         self.error: str | None = None
         self._warning: str | None = None
         self._repeats = 0
+        self._logged: list[logging.LogRecord] = []
         #: FMI unit of every registered variable (read by the build to write UnitDefinitions).
         self.units: dict[str, str] = {v.name: v.unit for v in (*parameters, *inputs, *outputs, *boolean_outputs)}
         for v in parameters:
@@ -173,15 +200,31 @@ class SlaveIO:
                            "refused: must be a finite number > 0; nothing was changed", Fmi2Status.error)
             return False
         if self.error is None:
+            thread = threading.get_ident()
             try:
+                _STEPPING[thread] = self
                 fn(current_time + step_size, step_size)
                 return True
             except Exception as exc:  # noqa: BLE001 - never let pythonfmu see an exception
                 self.error = f"step failed at t = {current_time!r} s: {type(exc).__name__}: {exc}"
                 self.slave.log(f"{self.slave.instance_name}: {self.error}\n{traceback.format_exc()}", Fmi2Status.error)
                 return False
+            finally:
+                _STEPPING.pop(thread, None)
+                if self._logged:
+                    self._forward_log(current_time + step_size)
         self.slave.log(f"{self.slave.instance_name}: {self.error}; the FMU cannot step", Fmi2Status.error)
         return False
+
+    def _forward_log(self, time: float) -> None:
+        """The step's ``marinefmu`` log records to the FMU log (module doc), less the bad-sample
+        message :meth:`warn` already logged."""
+        records, self._logged = self._logged, []
+        for record in records:
+            text = record.getMessage()
+            if self._warning is not None and self._warning in text:
+                continue
+            self.slave.log(f"{self.slave.instance_name}: t = {time:.4f} s: {text}", Fmi2Status.warning)
 
     def warn(self, message: str | None, time: float, valid: bool = False) -> None:
         """Report a rejected sample (``message``) or a good one (None) as an FMU warning.
