@@ -12,6 +12,13 @@ AttitudeEstimator: roll and pitch RMS over ``[SETTLE, duration]`` at the default
 σ_p = 3 σ_v, 10 Hz, and the paper-000 reproduction's 3 m/s, 10 m, 1 Hz); the figure of merit is
 the larger of roll and pitch. The goals: the defaults within :data:`RATIO_GOAL` of the grid's
 best on every case, and at most :data:`ATTITUDE_GOAL_DEG`.
+
+HeaveObserver: given only its monitoring point (:func:`monitoring_point`, relative to the IMU), at its
+defaults, fed by the AttitudeEstimator at its defaults, against the same observer fed by the
+case's best fixed aiding and by the true roll and pitch (what no attitude estimate beats); the
+real-time heave RMS error at the point from :data:`SETTLE` or the observer's first valid
+sample, whichever is later (:func:`point_heave_cm`). The goals: within :data:`RATIO_GOAL` of
+the best fixed aiding's, and the project's heave goal max(2 cm, 2.5 % of the point's heave std).
 """
 from __future__ import annotations
 
@@ -21,6 +28,8 @@ from dataclasses import replace
 import numpy as np
 
 from ..estimators.attitude.estimator import AttitudeEstimatorParams, estimate_attitude
+from ..estimators.heave.common import HeaveObserverParams
+from ..estimators.heave.observer import HeaveObserver
 from ..sea.motion_model import VesselMotionParams, simulate_record, stack
 from ..sea.vessel import PRESETS
 
@@ -45,6 +54,15 @@ def placements(preset: str) -> dict[str, tuple[float, float, float]]:
     return {"cog": (0.0, 0.0, 0.0), "far": (round(0.4 * h.length, 1), round(0.4 * h.beam, 1), -10.0)}
 
 
+def monitoring_point(preset: str, place: str) -> tuple[float, float, float]:
+    """The heave figure's monitoring point relative to the COG, body frame [m]: on the
+    centreline 10 m above the COG, 45 % of the length forward (a bow crane or gangway tip) for
+    the IMU at the COG, 45 % aft for the IMU forward (:func:`placements`), so that the point is
+    far from the IMU in both and the attitude error's lever arm is long."""
+    x = 0.45 * PRESETS[preset].length
+    return (round(x if place == "cog" else -x, 1), 0.0, -10.0)
+
+
 CASES: tuple[tuple[str, float, float, str], ...] = tuple(
     (preset, hs, tp, place) for preset in PRESETS for hs, tp in SEAS for place in ("cog", "far"))
 
@@ -55,29 +73,66 @@ def case_record(preset: str, hs: float, tp: float, place: str, duration: float =
     VesselMotion parameters (e.g. ``{"imu.grade": "mru"}``)."""
     imu = placements(preset)[place]
     flat = {"sea.hs": hs, "sea.tp": tp, "sea.seed": SEED, "sea.heading": HEADING, "vessel.preset": preset,
-            **{f"imu.{a}": v for a, v in zip("xyz", imu)}, **(extra or {})}
+            **{f"imu.{a}": v for a, v in zip("xyz", imu)},
+            **{f"point.{a}": v for a, v in zip("xyz", monitoring_point(preset, place))}, **(extra or {})}
     return simulate_record(VesselMotionParams.from_flat(flat), duration, DT)
 
 
 def attitude_rms_deg(rec: dict[str, np.ndarray], params: AttitudeEstimatorParams | None = None,
-                     settle: float = SETTLE) -> tuple[float, float]:
-    """Roll and pitch RMS error [deg] of the AttitudeEstimator over ``rec`` from ``settle`` on."""
-    out = estimate_attitude(stack(rec, "imu.gyro"), stack(rec, "imu.acc"), DT, params)
+                     settle: float = SETTLE, out: dict[str, np.ndarray] | None = None) -> tuple[float, float]:
+    """Roll and pitch RMS error [deg] of the AttitudeEstimator over ``rec`` from ``settle`` on
+    (``out``: its run on ``rec`` if already made, else it is run with ``params``)."""
+    if out is None:
+        out = estimate_attitude(stack(rec, "imu.gyro"), stack(rec, "imu.acc"), DT, params)
     k = int(settle / DT)
     roll = np.angle(np.exp(1j * (out["roll"][k:] - rec["truth.roll"][k:])))
     pitch = out["pitch"][k:] - rec["truth.pitch"][k:]
     return (float(np.degrees(np.sqrt(np.mean(roll ** 2)))), float(np.degrees(np.sqrt(np.mean(pitch ** 2)))))
 
 
+def point_heave_cm(rec: dict[str, np.ndarray], roll: np.ndarray, pitch: np.ndarray,
+                   arm: tuple[float, float, float], settle: float = SETTLE) -> tuple[float, float]:
+    """Real-time heave RMS error and true heave std [cm] at the monitoring point of ``rec``
+    (VesselMotion's ``point``; ``arm`` is it relative to the IMU, body frame [m]) of the
+    HeaveObserver at its defaults fed by ``roll``/``pitch`` [rad], from ``settle`` or its first
+    valid sample, whichever is later. Both the truth's and the error's means are removed: heave
+    is the motion about the mean position, and the observer has no output at zero frequency."""
+    obs = HeaveObserver(HeaveObserverParams(point=arm), quiet=True)
+    acc = stack(rec, "imu.acc")
+    heave = np.empty(len(acc))
+    valid = np.empty(len(acc), dtype=bool)
+    for k in range(len(acc)):
+        r = obs.step(acc[k], float(roll[k]), float(pitch[k]), DT)
+        heave[k], valid[k] = r.point_heave, r.valid
+    k0 = max(int(settle / DT), int(np.argmax(valid)) if valid.any() else len(valid))
+    truth = rec["truth.point.d"][k0:]
+    err = heave[k0:] - (truth - truth.mean())
+    err -= err.mean()
+    return 100.0 * float(np.sqrt(np.mean(err ** 2))), 100.0 * float(np.std(truth))
+
+
 def attitude_case(preset: str, hs: float, tp: float, place: str, extra: dict | None = None) -> dict:
-    """The defaults and every setting of :data:`ATTITUDE_GRID` on one case."""
+    """The defaults and every setting of :data:`ATTITUDE_GRID` on one case, and the heave at
+    :func:`monitoring_point` fed by the defaults, by the best fixed setting and by the true angles."""
     rec = case_record(preset, hs, tp, place, extra=extra)
+    gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
     base = AttitudeEstimatorParams()
-    default = attitude_rms_deg(rec, base)
-    grid = [{**g, "rms_deg": attitude_rms_deg(rec, replace(base, **g))} for g in ATTITUDE_GRID]
-    best = min(grid, key=lambda g: max(g["rms_deg"]))
+    runs = [estimate_attitude(gyro, acc, DT, base)]
+    runs += [estimate_attitude(gyro, acc, DT, replace(base, **g)) for g in ATTITUDE_GRID]
+    default = attitude_rms_deg(rec, out=runs[0])
+    grid = [{**g, "rms_deg": attitude_rms_deg(rec, out=out)} for g, out in zip(ATTITUDE_GRID, runs[1:])]
+    i_best = min(range(len(grid)), key=lambda i: max(grid[i]["rms_deg"]))
+    best = grid[i_best]
+    arm = tuple(round(float(p - q), 3) for p, q in zip(monitoring_point(preset, place), placements(preset)[place]))
+    heave = {name: point_heave_cm(rec, out["roll"], out["pitch"], arm)
+             for name, out in (("default", runs[0]), ("best_fixed", runs[1 + i_best]),
+                               ("true_angles", {"roll": rec["truth.roll"], "pitch": rec["truth.pitch"]}))}
+    std = heave["default"][1]
     return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "default_deg": default, "grid": grid,
-            "best": best, "ratio": max(default) / max(best["rms_deg"])}
+            "best": best, "ratio": max(default) / max(best["rms_deg"]),
+            "heave": {"arm_m": arm, "std_cm": std, "goal_cm": max(2.0, 0.025 * std),
+                      **{f"{k}_cm": v[0] for k, v in heave.items()},
+                      "ratio": heave["default"][0] / heave["best_fixed"][0]}}
 
 
 def defaults_bench(progress: bool = True) -> dict:
@@ -101,5 +156,20 @@ def defaults_bench(progress: bool = True) -> dict:
     worst = max(max(r["default_deg"]) for r in rows)
     worst_ratio = max(r["ratio"] for r in rows)
     print(f"worst default {worst:.4f} deg (goal {ATTITUDE_GOAL_DEG}), worst ratio {worst_ratio:.2f} (goal {RATIO_GOAL})")
+    print(f"HeaveObserver at its defaults, given the monitoring point only, fed by the AttitudeEstimator: real-time heave "
+          f"RMS error at the point [cm]; goals: <= {RATIO_GOAL} x fed by the best fixed aiding, <= max(2 cm, 2.5 % of std)")
+    print(f"{'vessel':<13} {'Hs':>4} {'Tp':>4} {'IMU':<4} {'arm x/y/z m':>17} {'std':>6} {'default':>8} "
+          f"{'best fixed':>10} {'true angles':>11} {'goal':>5} {'ratio':>6}")
+    for r in rows:
+        h = r["heave"]
+        arm = "/".join(f"{a:g}" for a in h["arm_m"])
+        print(f"{r['preset']:<13} {r['hs']:4.1f} {r['tp']:4.0f} {r['imu']:<4} {arm:>17} {h['std_cm']:6.1f} "
+              f"{h['default_cm']:8.2f} {h['best_fixed_cm']:10.2f} {h['true_angles_cm']:11.2f} {h['goal_cm']:5.2f} "
+              f"{h['ratio']:6.2f}")
+    heave_ratio = max(r["heave"]["ratio"] for r in rows)
+    heave_over = [r for r in rows if r["heave"]["default_cm"] > r["heave"]["goal_cm"]]
+    print(f"heave: worst ratio {heave_ratio:.2f} (goal {RATIO_GOAL}); over the heave goal on {len(heave_over)} of "
+          f"{len(rows)} cases")
     return {"attitude": {"cases": rows, "worst_deg": worst, "worst_ratio": worst_ratio,
-                         "goal_deg": ATTITUDE_GOAL_DEG, "goal_ratio": RATIO_GOAL}}
+                         "goal_deg": ATTITUDE_GOAL_DEG, "goal_ratio": RATIO_GOAL},
+            "heave": {"worst_ratio": heave_ratio, "over_goal": len(heave_over), "goal_ratio": RATIO_GOAL}}
