@@ -3,9 +3,13 @@
 :func:`write_day_record` writes the record (8.64 million rows: IMU, a 5 Hz GNSS antenna held
 between epochs with its ``new`` flag, and three reference signals) with numpy in chunks;
 :func:`recording_bench` then plays it whole in-process, in a fresh process of its own so that
-the resident-memory peak (``ru_maxrss``) is the player's, and through FMPy for a stretch of it
+the resident-memory peak (``VmHWM``, :func:`marinefmu.bench.system.peak_rss_mb`) is the player's, and through FMPy for a stretch of it
 (the FMI per-step overhead), and reports the opening scan's time, the steps per second and the
 peak resident memory of each. The goal of issue 51: ≤ 500 MB resident and ≥ 20,000 steps/s.
+
+The bound behind the FMPy figure, :func:`fmi_floor`: the same loop (``doStep``, nine reals and
+three booleans read per step) on an FMU with the recording's variables whose ``doStep`` does
+nothing. No player inside pythonfmu's slave can stream faster than that through FMPy.
 """
 from __future__ import annotations
 
@@ -62,7 +66,8 @@ def write_day_record(path: str | Path, hours: float = 24.0, rate: float = 100.0,
 
 
 _PLAYER = """
-import json, resource, sys, time
+import json, sys, time
+from marinefmu.bench.system import peak_rss_mb
 from marinefmu.sea.recording import SensorRecording, SensorRecordingParams
 path, mapping, steps, dt = sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4])
 t0 = time.perf_counter()
@@ -74,13 +79,17 @@ for k in range(n):
     p.step(k * dt + dt, dt)
 play = time.perf_counter() - t0
 print(json.dumps({"rows": p.record.summary.rows, "steps": n, "scan_s": scan, "play_s": play, "steps_per_s": n / play,
-                  "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+                  "max_rss_mb": peak_rss_mb(),
                   "ended": p.ended, "imu_invalid_steps": p.invalid_steps.get("imu.valid", 0)}))
 """
 
 _FMPY = """
-import json, resource, sys, time
+import json, sys, time
 from fmpy import extract, read_model_description
+def peak_rss_mb():   # VmHWM as marinefmu.bench.system.peak_rss_mb, without importing marinefmu here
+    for line in open("/proc/self/status"):
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1]) / 1024.0
 from fmpy.fmi2 import FMU2Slave
 fmu, path, mapping, steps, dt = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), float(sys.argv[5])
 md = read_model_description(fmu)
@@ -102,7 +111,7 @@ for k in range(steps):
 play = time.perf_counter() - t0
 s.terminate(); s.freeInstance()
 print(json.dumps({"steps": steps, "scan_s": scan, "play_s": play, "steps_per_s": steps / play,
-                  "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}))
+                  "max_rss_mb": peak_rss_mb()}))
 """
 
 
@@ -111,6 +120,15 @@ def _run(code: str, *args: str) -> dict:
     if done.returncode != 0:
         raise RuntimeError(f"recording benchmark failed:\n{done.stderr[-3000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def fmi_floor(fmu_dir: str | Path, work: str | Path, path: Path, steps: int, dt: float = 0.01) -> dict:
+    """Steps per second of the FMPy loop of :func:`recording_bench` on an idle copy of the
+    SensorRecording FMU (:func:`marinefmu.bench.system.idle_fmus`): the FMI call chain alone."""
+    from marinefmu.bench.system import idle_fmus
+
+    idle = idle_fmus(Path(fmu_dir), Path(work) / "idle_fmus", ("SensorRecording",))
+    return _run(_FMPY, str(idle / "SensorRecording.fmu"), str(path), str(path.with_suffix(".toml")), str(steps), repr(dt))
 
 
 def recording_bench(fmu_dir: str | Path, work: str | Path, hours: float = 24.0, fmpy_steps: int = 500_000,
@@ -124,10 +142,14 @@ def recording_bench(fmu_dir: str | Path, work: str | Path, hours: float = 24.0, 
     dt = 0.01
     player = _run(_PLAYER, str(path), str(mapping), "0", repr(dt))
     fmpy = _run(_FMPY, str(Path(fmu_dir) / "SensorRecording.fmu"), str(path), str(mapping), str(fmpy_steps), repr(dt))
+    floor = fmi_floor(fmu_dir, work, path, fmpy_steps, dt)
+    fmpy["share_of_floor"] = fmpy["steps_per_s"] / floor["steps_per_s"]
     out = {"record": {"hours": hours, "rows": player["rows"], "mb": path.stat().st_size / 1e6, "write_s": written},
-           "in_process": player, "fmpy": fmpy, "goal": {"max_rss_mb": GOAL_MB, "steps_per_s": GOAL_STEPS_S}}
+           "in_process": player, "fmpy": fmpy, "fmi_floor": floor,
+           "goal": {"max_rss_mb": GOAL_MB, "steps_per_s": GOAL_STEPS_S}}
     print(f"recording: {player['rows']:,} rows ({out['record']['mb']:.0f} MB CSV): opening scan {player['scan_s']:.0f} s; "
           f"in-process {player['steps_per_s']:,.0f} steps/s over {player['steps']:,} steps, peak RSS "
           f"{player['max_rss_mb']:.0f} MB; FMPy {fmpy['steps_per_s']:,.0f} steps/s over {fmpy['steps']:,} steps, peak RSS "
-          f"{fmpy['max_rss_mb']:.0f} MB (goal <= {GOAL_MB:.0f} MB, >= {GOAL_STEPS_S:,.0f} steps/s)", flush=True)
+          f"{fmpy['max_rss_mb']:.0f} MB; an FMU that does nothing, same loop: {floor['steps_per_s']:,.0f} steps/s "
+          f"(goal <= {GOAL_MB:.0f} MB, >= {GOAL_STEPS_S:,.0f} steps/s)", flush=True)
     return out
