@@ -207,43 +207,6 @@ def case_record(name: str, fmu_dir: Path, work: Path) -> dict:
     return {"steps": len(values), "finite": bool(np.all(np.isfinite(values)))}
 
 
-def case_run(name: str, fmu_dir: Path, work: Path) -> dict:
-    """Load, run 200 steps, report finiteness and whether marinefmu is importable here."""
-    import importlib.util
-
-    importable = importlib.util.find_spec("marinefmu") is not None  # before the FMU adds its resources
-    inst, feed = start(name, fmu_dir, work)
-    out = np.array(advance(inst, feed, 0, 200))
-    inst.close()
-    return {"finite": bool(np.all(np.isfinite(out))), "steps": len(out), "marinefmu_importable": importable,
-            "marinefmu_used": sys.modules["marinefmu"].__file__ if "marinefmu" in sys.modules else None,
-            "unzipped_to": str(_UNZIPPED[name]), "python": sys.executable}
-
-
-def case_libcosim_run(name: str, fmu_dir: Path, work: Path) -> dict:
-    """Load the FMU alone in a libcosim execution (inputs at their start values), run 200 steps."""
-    import importlib.util
-
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy.CosimSlave import CosimLocalSlave
-
-    importable = importlib.util.find_spec("marinefmu") is not None  # before the FMU adds its resources
-    log_output_level(CosimLogLevel.ERROR)
-    md = read_model_description(str(Path(fmu_dir) / f"{name}.fmu"))
-    reals = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
-    ex = CosimExecution.from_step_size(step_size=round(DT * 1e9))
-    index = ex.add_local_slave(CosimLocalSlave(fmu_path=str(Path(fmu_dir) / f"{name}.fmu"), instance_name=name))
-    obs = CosimObserver.create_last_value()
-    ex.add_observer(obs)
-    ok = ex.simulate_until(round(200 * DT * 1e9))
-    values = obs.last_real_values(index, reals)
-    return {"simulated": bool(ok), "finite": bool(np.all(np.isfinite(values))), "outputs": len(values),
-            "marinefmu_importable": importable,
-            "marinefmu_used": sys.modules["marinefmu"].__file__ if "marinefmu" in sys.modules else None}
-
-
 def case_two_instances(name: str, fmu_dir: Path, work: Path) -> dict:
     """Outputs of one instance alone vs. the same instance stepped alongside a second one that
     has different inputs (or, for VesselMotion, a different sea), past the warm-up."""
@@ -307,9 +270,13 @@ def case_state(name: str, fmu_dir: Path, work: Path) -> dict:
             "outputs_moving": int(np.sum(np.ptp(np.asarray(first), axis=0) > 0)), "real_outputs": len(inst.real_outputs)}
 
 
-#: Parameters that make every input of an FMU used (CentreOfRotation ignores its angle inputs
-#: unless angles = input).
-FAULT_PARAMS = {"CentreOfRotation": {"angles": "input"}}
+#: Settings under which the faults case tries an FMU, each with the inputs it leaves unread
+#: (default: PARAMS, every input read). CentreOfRotation ignores its angle inputs unless angles =
+#: input; GnssAccFusion reads them only with attitude = input, and then antenna 1 alone: it is
+#: tried both ways.
+FAULT_RUNS = {"CentreOfRotation": [({"angles": "input"}, ())],
+              "GnssAccFusion": [({}, ("roll", "pitch", "yaw")),
+                                ({"attitude": "input", "attitude_lag": DT}, ("gnss.ant2.", "gnss.ant3.", "gnss.ant4."))]}
 BAD_VALUES = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf, "1e12": 1e12}
 INJECT_EVERY = 40  # steps between two bad samples (2 s)
 
@@ -318,35 +285,41 @@ def case_faults(name: str, fmu_dir: Path, work: Path) -> dict:
     """For each bad value: after warm-up, one bad sample on each real input in turn, 2 s apart.
     Per injection: the step status, ``valid`` on that step, whether a warning was logged, and
     whether the output recovered (valid again) before the next injection."""
-    report: dict[str, dict] = {}
-    params = {**PARAMS[name], **FAULT_PARAMS.get(name, {})}
-    for label, bad in BAD_VALUES.items():
-        inst, feed = start(name, fmu_dir, work, f"f{label}", params)
-        k = WARM_UP[name]
-        advance(inst, feed, 0, k)
-        rows, finite = [], True
-        for v in inst.real_inputs:
-            if v.name.startswith("gnss."):  # antenna positions are a sample only on a new epoch
-                while not feed.bool["gnss.new"][k]:
-                    advance(inst, feed, k, k + 1)
-                    k += 1
-            reals, bools = feed.at(k)
-            reals[v.name] = bad
-            inst.set_inputs(reals, bools)
-            seen = len(inst.messages)
-            status = inst.step(k * DT, DT)
-            out = inst.outputs()
-            warned = any(s == WARNING for s, _ in inst.messages[seen:])
-            row = {"input": v.name, "status": status, "valid": inst.valid(), "warned": warned}
-            finite &= bool(np.all(np.isfinite(out)))
-            after = advance(inst, feed, k + 1, k + INJECT_EVERY)
-            finite &= bool(np.all(np.isfinite(after)))
-            row["recovered"] = inst.valid()
-            rows.append(row)
-            k += INJECT_EVERY
-        inst.close()
-        report[label] = {"finite": finite, "rows": rows}
+    report: dict[str, dict] = {label: {"finite": True, "rows": []} for label in BAD_VALUES}
+    for run, (extra, unread) in enumerate(FAULT_RUNS.get(name, [({}, ())])):
+        for label, bad in BAD_VALUES.items():
+            _faults(name, fmu_dir, work, f"f{run}{label}", {**PARAMS[name], **extra}, unread, bad, report[label])
     return report
+
+
+def _faults(name: str, fmu_dir: Path, work: Path, instance: str, params: dict, unread: tuple, bad: float,
+            report: dict) -> None:
+    """:func:`case_faults` for one setting and one bad value: its rows added to ``report``."""
+    inst, feed = start(name, fmu_dir, work, instance, params)
+    k = WARM_UP[name]
+    advance(inst, feed, 0, k)
+    for v in inst.real_inputs:
+        if unread and v.name.startswith(unread):
+            continue
+        if v.name.startswith("gnss."):  # antenna positions are a sample only on a new epoch
+            while not feed.bool["gnss.new"][k]:
+                advance(inst, feed, k, k + 1)
+                k += 1
+        reals, bools = feed.at(k)
+        reals[v.name] = bad
+        inst.set_inputs(reals, bools)
+        seen = len(inst.messages)
+        status = inst.step(k * DT, DT)
+        out = inst.outputs()
+        warned = any(s == WARNING for s, _ in inst.messages[seen:])
+        row = {"input": v.name, "status": status, "valid": inst.valid(), "warned": warned}
+        report["finite"] &= bool(np.all(np.isfinite(out)))
+        after = advance(inst, feed, k + 1, k + INJECT_EVERY)
+        report["finite"] &= bool(np.all(np.isfinite(after)))
+        row["recovered"] = inst.valid()
+        report["rows"].append(row)
+        k += INJECT_EVERY
+    inst.close()
 
 
 def case_zero_hour(name: str, fmu_dir: Path, work: Path) -> dict:
