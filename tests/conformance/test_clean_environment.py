@@ -78,9 +78,13 @@ if mode == "fmpy":
         rows = np.array(w.advance(inst, feed, 0, w.WARM_UP[name] + 50))
         n = len(rows)
         # outputs with a truth of the same name: largest error over the last 50 steps, and the truth's range
-        truth = {o: (float(np.abs(rows[-50:, i] - rec[n - 50:n, cols.index(f"truth.{o}")]).max()),
-                     float(np.ptp(rec[n - 50:n, cols.index(f"truth.{o}")])))
-                 for i, o in enumerate(inst.output_names) if f"truth.{o}" in cols}
+        # (an output "<x>_used", the angle an estimator applied, against truth.<x>)
+        truth = {}
+        for i, o in enumerate(inst.output_names):
+            key = o.removesuffix("_used")
+            if f"truth.{key}" in cols:
+                t = rec[n - 50:n, cols.index(f"truth.{key}")]
+                truth[key] = (float(np.abs(rows[-50:, i] - t).max()), float(np.ptp(t)))
         out[name] = {"finite": bool(np.all(np.isfinite(rows))), "valid": inst.valid(), "steps": n,
                      "first_output": inst.output_names[0], "first_output_moves": bool(np.ptp(rows[-50:, 0]) > 0),
                      "truth": truth, "errors": [m for s, m in inst.messages if s >= 3]}

@@ -205,13 +205,22 @@ class Record:
         self._index = used
         return names
 
-    def _parquet(self):
+    def _arrow(self):
+        """pyarrow, pyarrow.compute and pyarrow.parquet: the optional Parquet dependency, imported
+        only here (so an FMU's requirements list it as optional); without it a Parquet file is
+        refused naming the file and the install."""
         try:
+            import pyarrow as pa
+            import pyarrow.compute as pc
             import pyarrow.parquet as pq
         except ImportError:
             raise self._fail("is a Parquet file, which needs the optional package pyarrow (pip install marinefmu[parquet], "
                              "or pip install pyarrow); "
                              "or convert it to CSV") from None
+        return pa, pc, pq
+
+    def _parquet(self):
+        pq = self._arrow()[2]
         try:
             return pq.ParquetFile(self.path)
         except Exception as exc:  # noqa: BLE001 - pyarrow raises its own types
@@ -358,9 +367,7 @@ class Record:
 
     def _parquet_numbers(self, arr, rows: np.ndarray, column: str) -> np.ndarray:
         """A Parquet column as float, null → the empty marker (module docstring: accepted types)."""
-        import pyarrow as pa
-        import pyarrow.compute as pc
-
+        pa, pc, _ = self._arrow()
         if pa.types.is_dictionary(arr.type):
             arr = arr.dictionary_decode()
         t = arr.type
@@ -390,8 +397,7 @@ class Record:
     def _parquet_times(self, arr, rows: np.ndarray) -> np.ndarray:
         """The time column of ``time.unit = "iso8601"``: a Parquet timestamp (UTC if it has a time
         zone) or ISO-8601 text (as in a CSV), to datetime64[ns]; a null is NaT (refused later)."""
-        import pyarrow as pa
-
+        pa = self._arrow()[0]
         if pa.types.is_dictionary(arr.type):
             arr = arr.dictionary_decode()
         t = arr.type
