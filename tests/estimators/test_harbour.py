@@ -86,7 +86,10 @@ def test_attitude_stays_valid_and_level_with_its_aiding_at_the_floor(variant, ca
     """After levelling (10 s) valid throughout, roll and pitch within 1 mrad (exactly 0 without
     noise); the auto-sized σ_v at :data:`~.attitude.estimator.SIGMA_V_MIN` per axis (noise and
     the filter's own tilt leave up to 2.5 times that), σ_p = POS_RATIO σ_v, and the filter's
-    covariance positive and steady over the last 20 s (with noise, within a factor 2)."""
+    covariance positive; with noise steady over the last 20 s within a factor 2. Without noise
+    the sized gyro noise is :data:`~.attitude.estimator.GYRO_NOISE_MIN` and the covariance
+    shrinks towards its steady state, still shrinking at 120 s (measured over an hour: steady
+    from 12 minutes on, smallest eigenvalue 7.9e-15, valid and exactly level throughout)."""
     acc, gyro = imu(120.0, DT, variant)
     est = AttitudeEstimator()
     out, sigmas, pdiag = [], [], []
@@ -106,8 +109,8 @@ def test_attitude_stays_valid_and_level_with_its_aiding_at_the_floor(variant, ca
     assert np.all(sigma_v >= att.SIGMA_V_MIN)
     assert np.all(sigma_v <= (2.5 if variant == "noisy" else 1.0) * att.SIGMA_V_MIN), sigma_v
     np.testing.assert_allclose(sigmas[-1][0:2], att.POS_RATIO * sigma_v, rtol=1e-12)
-    if variant == "exact":      # steady: an hour adds nothing
-        np.testing.assert_allclose(pdiag[-1], pdiag[-20], rtol=1e-4)
+    if variant == "exact":      # shrinking towards its steady state, never below zero
+        assert np.all(pdiag[-1] <= pdiag[-20] * (1.0 + 1e-12)) and est.gyro_noise_used == att.GYRO_NOISE_MIN
     else:                       # the sizing follows the noise, and the covariance the sizing
         assert np.all(pdiag[-1] < 2.0 * pdiag[-20]) and np.all(pdiag[-1] > 0.5 * pdiag[-20])
     assert warnings_of(caplog) == []

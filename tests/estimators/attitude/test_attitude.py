@@ -73,12 +73,19 @@ def test_gyro_only_tracks_noise_free_truth():
 
 
 def test_aided_mode_estimates_a_constant_gyro_bias_at_rest():
+    """A MEMS gyro (the default grade's noise, seeded) with a turn-on bias 40 times the bias
+    prior, at rest for 600 s: the bias is found to 2 % and roll and pitch to 0.01° (measured
+    1 % and 0.008°). The sensors are noisy because the auto sizing takes a noiseless gyro for a
+    perfect one, whose tilt it then does not correct."""
     bias = np.array([2e-3, -1.5e-3, 0.0])
     roll, pitch = 0.05, -0.03
     f = rot_nb(roll, pitch, 0.0).T @ np.array([0.0, 0.0, -G])
+    rng = np.random.default_rng(5)
+    gyro = bias + 5e-5 / math.sqrt(0.01) * rng.standard_normal((60000, 3))
+    acc = f + 7e-4 / math.sqrt(0.01) * rng.standard_normal((60000, 3))
     est = AttitudeEstimator(AttitudeEstimatorParams(init="given", init_euler=(roll, pitch, 0.0), vel_sigma=0.1, pos_sigma=0.1))
-    for _ in range(60000):  # 600 s
-        r = est.step(bias, f, 0.01)
+    for k in range(60000):  # 600 s
+        r = est.step(gyro[k], acc[k], 0.01)
     np.testing.assert_allclose(r.gyro_bias[:2], bias[:2], rtol=0.02)
     assert abs(r.roll - roll) < math.radians(0.01) and abs(r.pitch - pitch) < math.radians(0.01)
     gyro_only = estimate_attitude(np.tile(bias, (60000, 1)), np.tile(f, (60000, 1)), 0.01,

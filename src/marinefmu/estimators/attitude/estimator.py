@@ -51,6 +51,30 @@ the decision record on the attitude defaults). The integrator does not see the f
 corrections, so the sizing does not feed back on itself. Until the statistics have filled
 (the first :data:`LEAK_TAU` seconds after levelling) ``vel_sigma`` and ``pos_sigma`` are used;
 ``aid_sizing = "fixed"`` uses them throughout.
+
+The gyro's noise is sized the same way, because the estimator does not know the grade of the
+IMU it is given (a MEMS unit's gyro is seventeen times noisier than an MRU's, and a filter that
+assumes MEMS trusts an MRU's gyro too little: 0.010° instead of 0.002° roll on the ``mru``
+grade). With ``aid_sizing = "auto"`` the white-noise density comes from the second difference of
+the gyro samples: for white noise of standard deviation σ per sample, d_k = ω_{k+1} − 2ω_k +
+ω_{k−1} has variance 6σ², while a vessel's rate, smooth at 100 Hz, contributes its third
+derivative times Δt², below 2·10⁻⁵ rad/s even for a 5° roll at 1.3 rad/s. So
+
+.. math::
+    \\hat N = \\sqrt{\\overline{d^2}\\,Δt / 6},\\qquad
+    N_{gyro} = \\max(N_{min}, \\hat N),\\qquad
+    σ_b = σ_{b,0}\\, N_{gyro} / N_0
+
+(the running mean over the three axes, time constant :data:`STATS_TAU`; N_0, σ_{b,0} the
+``gyro_noise`` and ``gyro_bias_sigma`` given, whose ratio, 1 s^-½ by default as the ``mems``
+grade, is kept: of the grades, bias instability falls with the noise; the MEMS ratio
+overstates an MRU's bias twelvefold, and the ``mru`` grade then reaches 0.004° roll and pitch
+against 0.002° told its own figures; :data:`GYRO_NOISE_MIN`). A vibrating mount raises N̂, which makes the filter trust the gyro less:
+the safe side. The noise model is used from :data:`NOISE_SETTLE` seconds of samples on; until
+then, and with ``aid_sizing = "fixed"`` throughout, ``gyro_noise`` and ``gyro_bias_sigma`` as
+given. Rejected samples (held) do not enter the mean. The initial bias covariance stays
+``gyro_bias_sigma``²: it is the prior on the unknown turn-on bias, which the sizing does not
+measure (a quiet gyro may still start with a large bias).
 Yaw has no aid (no heading sensor): it is the integrated (bias-free-in-x/y) gyro yaw and
 drifts with the z-gyro bias.
 
@@ -87,6 +111,12 @@ LEAK_TAU = 40.0
 AID_GAIN = 1.5
 POS_RATIO = 3.0
 SIGMA_V_MIN = 0.05
+#: Least gyro white-noise density of the auto sizing [rad/s/√Hz]: 0.0003 °/√h, below the best
+#: navigation-grade fibre-optic gyros (0.0005-0.001 °/√h), so a noiseless or quantised input
+#: (a recording of a unit at rest) still gets a positive process noise.
+GYRO_NOISE_MIN = 1e-7
+#: Samples of gyro noise statistics [s] before the sized gyro noise is used.
+NOISE_SETTLE = 10.0
 
 
 @dataclass(frozen=True)
@@ -105,7 +135,8 @@ class AttitudeEstimatorParams:
     level_time : float
         Levelling time [s], 0.1 … 600. [``level_time``]
     gyro_noise : float
-        Gyro white-noise density [rad/s/√Hz], (0, 1]. [``gyro_noise``]
+        Gyro white-noise density [rad/s/√Hz], (0, 1]; with ``aid_sizing = "auto"`` the start
+        of the sizing and, with ``gyro_bias_sigma``, the ratio it keeps. [``gyro_noise``]
     acc_noise : float
         Accelerometer white-noise density [m/s²/√Hz], (0, 10]. [``acc_noise``]
     gyro_bias_sigma : float
@@ -123,8 +154,9 @@ class AttitudeEstimatorParams:
     aid_rate : float
         Rate of the pseudo-measurement [Hz], (0, 100]. [``aid_rate``]
     aid_sizing : str
-        ``"auto"`` (default) sizes ``vel_sigma`` and ``pos_sigma`` from the measured motion as
-        it runs (module docstring), ``"fixed"`` uses them as given. [``aid_sizing``]
+        ``"auto"`` (default) sizes ``vel_sigma`` and ``pos_sigma`` from the measured motion, and
+        ``gyro_noise`` and ``gyro_bias_sigma`` from the gyro's measured noise, as it runs
+        (module docstring); ``"fixed"`` uses them as given. [``aid_sizing``]
     """
 
     mode: int = 1
@@ -268,6 +300,13 @@ class AttitudeEstimator:
         self.ms_v = np.zeros(2)
         self.stats_weight = 0.0
         self.stats_time = 0.0
+        # auto sizing of the gyro noise: the last two good samples and the running mean of d²
+        self.gyro_hist: list[np.ndarray] = []
+        self.ms_d2 = 0.0
+        self.d2_weight = 0.0
+        self.d2_time = 0.0
+        self.gyro_noise_used = p.gyro_noise
+        self.gyro_bias_sigma_used = p.gyro_bias_sigma
 
     # ---- step ---------------------------------------------------------------------------------
     def step(self, gyro: Any, acc: Any, dt: float) -> AttitudeResult:
@@ -296,6 +335,9 @@ class AttitudeEstimator:
             if self.last_gyro is None:
                 return self._result(False, warning)
             gyro, acc = self.last_gyro, self.last_acc
+            self.gyro_hist.clear()  # a second difference spans consecutive good samples only
+        elif self.params.aid_sizing == "auto":
+            self._gyro_statistics(gyro, dt)
         w_prev = gyro if self.last_gyro is None else self.last_gyro
         omega = 0.5 * (w_prev + gyro) - self.bias
         self.last_gyro, self.last_acc = gyro, acc
@@ -344,6 +386,8 @@ class AttitudeEstimator:
             if p.aid_sizing == "auto" and self.stats_time >= LEAK_TAU:
                 sigma_v = np.maximum(SIGMA_V_MIN, AID_GAIN * np.sqrt(self.ms_v / self.stats_weight))
                 kf.R = np.diag(np.concatenate(((POS_RATIO * sigma_v) ** 2, sigma_v ** 2)))
+            if p.aid_sizing == "auto" and self.d2_time >= NOISE_SETTLE:
+                self._size_gyro_noise(dt)
             kf.update(np.concatenate((self.pos, self.vel)))
             dx = kf.x.ravel()
             self.pos -= dx[0:2]
@@ -366,6 +410,36 @@ class AttitudeEstimator:
         self.stats_weight += beta * (1.0 - self.stats_weight)
         self.stats_time += dt
 
+    def _gyro_statistics(self, gyro: np.ndarray, dt: float) -> None:
+        """Running mean of the squared second difference of the good gyro samples [(rad/s)²],
+        over the three axes (module docstring); exponential, time constant :data:`STATS_TAU`,
+        start-corrected by its weight."""
+        hist = self.gyro_hist
+        hist.append(gyro)
+        if len(hist) < 3:
+            return
+        d = hist[2] - 2.0 * hist[1] + hist[0]
+        del hist[0]
+        beta = dt / STATS_TAU
+        self.ms_d2 += beta * (float(d @ d) / 3.0 - self.ms_d2)
+        self.d2_weight += beta * (1.0 - self.d2_weight)
+        self.d2_time += dt
+
+    def _size_gyro_noise(self, dt: float) -> None:
+        """The gyro's white-noise density and bias σ from :meth:`_gyro_statistics` into the
+        process noise (module docstring)."""
+        p = self.params
+        n_hat = math.sqrt(self.ms_d2 / self.d2_weight * dt / 6.0)
+        self.gyro_noise_used = max(GYRO_NOISE_MIN, n_hat)
+        self.gyro_bias_sigma_used = p.gyro_bias_sigma * self.gyro_noise_used / p.gyro_noise
+        self._set_gyro_process_noise()
+
+    def _set_gyro_process_noise(self) -> None:
+        """The gyro's entries of the process-noise density: white noise on ε, Gauss–Markov
+        driving noise 2σ_b²/τ_b on the bias."""
+        self._q_diag[4, 4] = self._q_diag[5, 5] = self.gyro_noise_used ** 2
+        self._q_diag[6, 6] = self._q_diag[7, 7] = 2.0 * self.gyro_bias_sigma_used ** 2 / self.params.gyro_bias_tau
+
     def _result(self, valid: bool, warning: str | None) -> AttitudeResult:
         roll, pitch, yaw = quat_to_euler(self.q)
         return AttitudeResult(roll, pitch, yaw, tuple(self.q.tolist()), tuple(self.bias.tolist()), valid, warning)
@@ -383,6 +457,9 @@ class AttitudeEstimator:
             "acc_mean": None if self.acc_mean is None else self.acc_mean.tolist(),
             "leak_v": self.leak_v.tolist(), "ms_v": self.ms_v.tolist(),
             "stats_weight": self.stats_weight, "stats_time": self.stats_time,
+            "gyro_hist": [g.tolist() for g in self.gyro_hist], "ms_d2": self.ms_d2, "d2_weight": self.d2_weight,
+            "d2_time": self.d2_time, "gyro_noise_used": self.gyro_noise_used,
+            "gyro_bias_sigma_used": self.gyro_bias_sigma_used,
         }
 
     def set_state(self, s: dict) -> None:
@@ -400,6 +477,10 @@ class AttitudeEstimator:
         self.acc_mean = None if s["acc_mean"] is None else np.array(s["acc_mean"])
         self.leak_v, self.ms_v = np.array(s["leak_v"]), np.array(s["ms_v"])
         self.stats_weight, self.stats_time = float(s["stats_weight"]), float(s["stats_time"])
+        self.gyro_hist = [np.array(g) for g in s["gyro_hist"]]
+        self.ms_d2, self.d2_weight, self.d2_time = float(s["ms_d2"]), float(s["d2_weight"]), float(s["d2_time"])
+        self.gyro_noise_used, self.gyro_bias_sigma_used = float(s["gyro_noise_used"]), float(s["gyro_bias_sigma_used"])
+        self._set_gyro_process_noise()
 
 
 def estimate_attitude(gyro: np.ndarray, acc: np.ndarray, dt: float, params: AttitudeEstimatorParams | None = None) -> dict[str, np.ndarray]:
