@@ -19,6 +19,10 @@ case's best fixed aiding and by the true roll and pitch (what no attitude estima
 real-time heave RMS error at the point from :data:`SETTLE` or the observer's first valid
 sample, whichever is later (:func:`point_heave_cm`). The goals: within :data:`RATIO_GOAL` of
 the best fixed aiding's, and the project's heave goal max(2 cm, 2.5 % of the point's heave std).
+
+The GnssAccFusion, DisplacementReconstructor and CentreOfRotation on the same cases are in
+:mod:`.defaults_fusion`, :mod:`.defaults_reconstruction` and :mod:`.defaults_cr`;
+:func:`defaults_bench` runs all five.
 """
 from __future__ import annotations
 
@@ -136,15 +140,26 @@ def attitude_case(preset: str, hs: float, tp: float, place: str, extra: dict | N
 
 
 def defaults_bench(progress: bool = True) -> dict:
-    """Every case of :data:`CASES` (module docstring), printed as a table; about 20 minutes on
-    a 2-core machine (two cases at a time)."""
+    """Every case of :data:`CASES` (module docstring) for the AttitudeEstimator and the
+    HeaveObserver here, and for the GnssAccFusion, DisplacementReconstructor and
+    CentreOfRotation (:mod:`.defaults_fusion`, :mod:`.defaults_reconstruction`,
+    :mod:`.defaults_cr`), printed as tables; two cases at a time, about 2.5 hours on a 2-core
+    machine (the reconstructor's grid is the most of it)."""
     from concurrent.futures import ProcessPoolExecutor
 
     from tqdm import tqdm
 
+    from .defaults_cr import cr_case, print_cr
+    from .defaults_fusion import fusion_case, print_fusion
+    from .defaults_reconstruction import print_reconstruction, reconstruction_case
+
+    kinds = {"attitude": attitude_case, "fusion": fusion_case, "reconstruction": reconstruction_case, "cr": cr_case}
     with ProcessPoolExecutor(max_workers=min(2, len(CASES))) as pool:  # one case per core
-        jobs = [pool.submit(attitude_case, *case) for case in CASES]
-        rows = [job.result() for job in tqdm(jobs, unit="case", desc="defaults", disable=not progress)]
+        jobs = [(kind, pool.submit(run, *case)) for kind, run in kinds.items() for case in CASES]
+        done: dict[str, list] = {kind: [] for kind in kinds}
+        for kind, job in tqdm(jobs, unit="case", desc="defaults", disable=not progress):
+            done[kind].append(job.result())
+    rows = done["attitude"]
     print(f"AttitudeEstimator at its defaults (geometry only) against the best fixed aiding of {len(ATTITUDE_GRID)}; "
           f"goals: <= {ATTITUDE_GOAL_DEG} deg and <= {RATIO_GOAL} x the best")
     print(f"{'vessel':<13} {'Hs':>4} {'Tp':>4} {'IMU':<4} {'default roll/pitch deg':>23} {'best fixed':>17} "
@@ -170,6 +185,12 @@ def defaults_bench(progress: bool = True) -> dict:
     heave_over = [r for r in rows if r["heave"]["default_cm"] > r["heave"]["goal_cm"]]
     print(f"heave: worst ratio {heave_ratio:.2f} (goal {RATIO_GOAL}); over the heave goal on {len(heave_over)} of "
           f"{len(rows)} cases")
+    print_fusion(done["fusion"])
+    print_reconstruction(done["reconstruction"])
+    cr = print_cr(done["cr"])
     return {"attitude": {"cases": rows, "worst_deg": worst, "worst_ratio": worst_ratio,
                          "goal_deg": ATTITUDE_GOAL_DEG, "goal_ratio": RATIO_GOAL},
-            "heave": {"worst_ratio": heave_ratio, "over_goal": len(heave_over), "goal_ratio": RATIO_GOAL}}
+            "heave": {"worst_ratio": heave_ratio, "over_goal": len(heave_over), "goal_ratio": RATIO_GOAL},
+            "fusion": {"cases": done["fusion"], "worst_ratio": max(r["ratio"] for r in done["fusion"])},
+            "reconstruction": {"cases": done["reconstruction"]},
+            "cr": {"cases": done["cr"], **cr}}

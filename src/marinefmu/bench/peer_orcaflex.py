@@ -241,7 +241,7 @@ def fusion_parameters(dt: float, q: tuple[float, float], lag: float = 0.0) -> di
     """The one-receiver fusion's settings, FMI-named (the GnssAccFusion FMU's and, through
     :func:`~marinefmu.fmu.tables.fusion_params`, :func:`receiver_fusion`'s): ``attitude =
     "input"``, the receiver and the accelerometer at the IMU point (the record's origin; no lever
-    arm), R = :data:`RECEIVER_SIGMA`² (r = σ²Δt for the step ``dt``), ``q`` = (q, q_down), and
+    arm), R = :data:`RECEIVER_SIGMA`² (r = σ²Δt for the step ``dt``, ``noise_sizing = "fixed"``), ``q`` = (q, q_down), and
     ``attitude_lag`` = ``lag`` [s] (one step through the FMUs: the co-simulation's coupling).
 
     ``coast = "inertial"``: the records have no gap longer than the 2 s after which the default
@@ -249,7 +249,7 @@ def fusion_parameters(dt: float, q: tuple[float, float], lag: float = 0.0) -> di
     the run) and change nothing."""
     at_imu = {f"{v}.{a}": 0.0 for v in ("ant1", "acc_lever_arm") for a in "xyz"}
     return {"attitude": "input", "attitude_lag": lag, "q": q[0], "q_down": q[1], "r": RECEIVER_SIGMA ** 2 * dt,
-            "coast": "inertial", **at_imu}
+            "noise_sizing": "fixed", "coast": "inertial", **at_imu}
 
 
 def receiver_fusion(acc: np.ndarray, euler: np.ndarray, gnss: np.ndarray, dt: float, q: tuple[float, float],

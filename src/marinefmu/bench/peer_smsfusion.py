@@ -153,7 +153,7 @@ def system_sea(hs: float, tp: float, duration: float, dt: float = 0.01) -> tuple
     -------
     tuple
         The record (``simulate_record``), the IMU position relative to the COG (body frame [m])
-        and the scenario's GnssAccFusion overrides (``r``, ``q``, ``q_down``) for :func:`compare_gnss_aided`.
+        and the scenario's GnssAccFusion overrides (``r``, ``q``, ``q_down``, ``noise_sizing``) for :func:`compare_gnss_aided`.
     """
     from ..cosim.scenarios import load_scenario
     from ..sea.motion_model import VesselMotionParams, simulate_record
@@ -161,5 +161,5 @@ def system_sea(hs: float, tp: float, duration: float, dt: float = 0.01) -> tuple
     system = load_scenario("system").system
     flat = {**system.component("vessel").parameters, "sea.hs": hs, "sea.tp": tp}
     imu = tuple(float(flat[f"imu.{a}"]) for a in "xyz")
-    fusion = {k: system.component("fusion").parameters[k] for k in ("r", "q", "q_down")}
+    fusion = {k: system.component("fusion").parameters[k] for k in ("r", "q", "q_down", "noise_sizing")}
     return simulate_record(VesselMotionParams.from_flat(flat), duration, dt), imu, fusion

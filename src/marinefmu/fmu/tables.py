@@ -18,6 +18,7 @@ from ..estimators.heave.common import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_
 from ..estimators.heave.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
 from ..estimators.gnss_fusion.antenna_attitude import ANTENNAS
 from ..estimators.gnss_fusion.filter import ATTITUDE_CHOICES as FUSION_ATTITUDE_CHOICES
+from ..estimators.gnss_fusion.filter import NOISE_SIZINGS as FUSION_NOISE_SIZINGS
 from ..estimators.gnss_fusion.filter import COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, GnssAccFusionParams
 from ..estimators.reconstruction.decomposition import TILT_CHOICES
 from ..estimators.reconstruction.sliding import DisplacementReconstructorParams
@@ -40,7 +41,7 @@ ATTITUDE_PARAMETERS: list[Variable] = [
     real("acc_noise", _ATT.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 10]"),
     real("gyro_bias_sigma", _ATT.gyro_bias_sigma, "rad/s", "Gyro bias standard deviation, (0, 1]"),
     real("gyro_bias_tau", _ATT.gyro_bias_tau, "s", "Gyro bias correlation time, 1..1e6"),
-    Variable("aid_sizing", "string", _ATT.aid_sizing, "", f"Aiding size: one of {', '.join(AID_SIZINGS)} (auto: vel_sigma and pos_sigma sized from the measured motion; fixed: as given)"),
+    Variable("aid_sizing", "string", _ATT.aid_sizing, "", f"Aiding size: one of {', '.join(AID_SIZINGS)} (auto: vel_sigma and pos_sigma sized from the measured motion, gyro_noise and gyro_bias_sigma from the gyro's measured noise; fixed: as given)"),
     real("vel_sigma", _ATT.vel_sigma, "m/s", "Zero-velocity pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 100]"),
     real("pos_sigma", _ATT.pos_sigma, "m", "Zero-position pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 1000]"),
     real("aid_rate", _ATT.aid_rate, "Hz", "Pseudo-measurement rate, (0, 100]"),
@@ -116,8 +117,9 @@ FUSION_PARAMETERS: list[Variable] = [
     *[v for i, arm in enumerate(_FU.antennas) for v in vec(f"ant{i + 1}", "xyz", arm, "m", f"GNSS antenna {i + 1} lever arm relative to the COG, body frame")],
     *vec("acc_lever_arm", "xyz", 0.0, "m", "Accelerometer position relative to the COG, body frame"),
     real("q", _FU.q, "m2/s3", "Acceleration process-noise density (paper 001 eq. 16), > 0"),
-    real("q_down", 0.0, "m2/s3", "Process-noise density of the down axis, > 0; 0 = the same as q (the paper)"),
-    real("r", _FU.r, "m2*s", "GNSS position noise, R = r/dt (paper 001 eq. 17), > 0"),
+    real("q_down", _FU.q_down, "m2/s3", "Process-noise density of the down axis, > 0; 0 = the same as q (the paper)"),
+    real("r", _FU.r, "m2*s", "GNSS position noise, R = r/dt (paper 001 eq. 17), > 0; with noise_sizing = auto the value for a 1 Hz receiver of 1 cm / 1.5 cm antenna noise"),
+    Variable("noise_sizing", "string", _FU.noise_sizing, "", f"R from the data: one of {', '.join(FUSION_NOISE_SIZINGS)} (auto: r scaled by the measured epoch rate and antenna-fit residual; fixed: R = r/dt as given)"),
     Variable("attitude_correction", "boolean", True, "", "Rotate the specific force with the attitude (false: the paper's uncorrected case)"),
     Variable("propagation", "string", _FU.propagation, "", f"Attitude between GNSS epochs: one of {', '.join(PROPAGATION_CHOICES)} (gyro needs gyro.* inputs)"),
     Variable("step_input", "string", _FU.step_input, "", f"Acceleration and rate over a step: one of {', '.join(STEP_INPUT_CHOICES)} (mean of the two bounding samples, or the latest held as the paper)"),
@@ -174,7 +176,8 @@ def fusion_params(values: dict[str, Any]) -> GnssAccFusionParams:
     xyz = lambda prefix: tuple(v[f"{prefix}.{a}"] for a in "xyz")  # noqa: E731
     return GnssAccFusionParams(
         antennas=tuple(xyz(f"ant{i + 1}") for i in range(ANTENNAS)), acc_lever_arm=xyz("acc_lever_arm"),
-        attitude=v["attitude"], attitude_lag=v["attitude_lag"], q=v["q"], q_down=v["q_down"] or None, r=v["r"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
+        attitude=v["attitude"], attitude_lag=v["attitude_lag"], q=v["q"], q_down=v["q_down"] or None, r=v["r"],
+        noise_sizing=v["noise_sizing"], attitude_correction=bool(v["attitude_correction"]), propagation=v["propagation"],
         step_input=v["step_input"], attitude_tau=v["attitude_tau"], gate=v["gate"], bias_states=bool(v["bias_states"]), bias_rw=v["bias_rw"],
         max_residual=v["max_residual"], reinit_time=v["reinit_time"], max_coast=v["max_coast"],
         coast=v["coast"], coast_sigma=v["coast_sigma"], coast_attitude_tau=v["coast_attitude_tau"],

@@ -50,6 +50,7 @@ def test_with_the_filters_own_noises_it_is_the_filters_covariance(monkeypatch):
     p = paper001.params(coast="inertial")
     sigma = 2.0 * math.sqrt(p.r / paper001.DT)
     est = GnssAccFusion(GnssAccFusionParams(antennas=p.antennas, acc_lever_arm=p.acc_lever_arm, coast="inertial",
+                                     q=p.q, q_down=p.q_down, r=p.r, noise_sizing="fixed",
                                      acc_noise=math.sqrt(p.q), antenna_sigma_h=sigma, antenna_sigma_v=sigma,
                                      gyro_noise=1e-12, gyro_bias_sigma=1e-12))
     rec = paper001.simulate(30.0, {"gnss.rate": 5.0})

@@ -173,7 +173,7 @@ def test_paper_mode_equals_a_plain_filterpy_run_of_eqs_13_to_19():
     gnss = (pos[:, None, :] + ARMS[None] + rng.normal(size=(n, 1, 3)) * 0.01).reshape(n, 12)
     new = (np.arange(n) + 1) % 20 == 0
     p = GnssAccFusionParams(q=q, r=r, gate=math.inf, bias_states=False, attitude_correction=False, propagation="hold",
-                     step_input="latest")
+                     step_input="latest", q_down=None, noise_sizing="fixed")
     ours = fuse(f_b, dt, gnss, new, params=p)
     kf = KalmanFilter(dim_x=6, dim_z=3)
     kf.F, kf.B = transition(dt, False)

@@ -27,7 +27,9 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
 3. **Kalman fusion** (filterpy ``KalmanFilter``): per axis the constant-acceleration model of
    eqs. 13-19, x = [d, v], Φ = [[1, Δt], [0, 1]], G = [Δt²/2, Δt], u = a_n,
    Q = q·[[Δt³/3, Δt²/2], [Δt²/2, Δt]] (eq. 16), R = r/Δt (eq. 17), Δt the accelerometer
-   interval; multirate: predict every sample, update at GNSS epochs. The acceleration and
+   interval, with r sized to the receiver's measured epoch rate and antenna noise
+   (``noise_sizing="auto"``, default: :meth:`GnssAccFusion._sized_r`) or as given
+   (``"fixed"``, the paper); multirate: predict every sample, update at GNSS epochs. The acceleration and
    the angular rate over a step are the means of the two samples that bound it
    (``step_input="mean"``, default), not the latest sample held (``"latest"``, the paper's
    eq. 15 with a_k): a held sample makes the predicted velocity err by (Δt/2)·a(t) and the
@@ -108,7 +110,7 @@ from ...errors import ParameterError, check_choice, check_range, check_vector
 from ...frames import GRAVITY_N, cross3, euler_to_quat, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
 from ..samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
 from .antenna_attitude import ANTENNAS, DEFAULT_ANTENNAS, MIN_SPREAD, AntennaFix, antenna_attitude, antenna_attitude_std
-from .error_model import FusionError, pi_gains
+from .error_model import FusionError, pi_gains, skew
 from .wave_coast import WaveCoast
 
 log = logging.getLogger(__name__)
@@ -117,6 +119,25 @@ PROPAGATION_CHOICES = ("gyro", "hold")
 STEP_INPUT_CHOICES = ("mean", "latest")
 COAST_CHOICES = ("band", "inertial")
 ATTITUDE_CHOICES = ("antennas", "input")
+NOISE_SIZINGS = ("auto", "fixed")
+#: ``noise_sizing="auto"``: ``r`` is the setting for a receiver that fixes once every
+#: :data:`FIX_INTERVAL_REF` s [s] ...
+FIX_INTERVAL_REF = 1.0
+#: ... with antenna noise of these standard deviations, horizontal and vertical [m] (RTK;
+#: VesselMotion's default receiver).
+SIGMA_REF = (0.01, 0.015)
+#: Memory of the running mean of the antenna-fit residual's square [usable epochs, accepted
+#: or gated out]; before that many, the mean over all so far.
+NOISE_MEMORY = 100
+#: The interval T̂ of ``noise_sizing="auto"`` is the median of this many latest intervals
+#: between GNSS epochs: a dropout or a skipped epoch moves it by one sample, a new receiver
+#: rate takes over within half of them.
+INTERVAL_MEMORY = 9
+#: Bounds of the noise factor of ``noise_sizing="auto"`` (the measured antenna noise's
+#: variance over the reference's): a noise-free record (a simulation without noise) would
+#: otherwise give R = 0, and the largest usable residual (``max_residual``) is far inside the
+#: upper bound.
+NOISE_FACTOR_RANGE = (0.01, 1e4)
 #: The rigid antenna set at identity attitude that carries one receiver's fix through the antenna
 #: solution (``attitude="input"``, module docstring item 5): the default antennas about their
 #: centroid, body frame [m].
@@ -167,18 +188,33 @@ class GnssAccFusionParams:
         times that tilt goes into the horizontal acceleration (docs/fmus/GnssAccFusion.md has
         what it costs on a record). [``attitude_lag``]
     q : float
-        Acceleration process-noise density of eq. 16 [m²/s³], > 0. [``q``]
+        Acceleration process-noise density of eq. 16 [m²/s³], > 0. The default 1e-3 is the
+        best of the benchmark's grid (part ``defaults``: 3 vessels × 3 seas × 2 IMU
+        placements, 5 Hz RTK; docs/decisions/gnss-fusion-defaults.md) with the auto-sized R;
+        paper 001's reproduction (1 Hz) keeps its own tuning, 0.005 with R fixed. [``q``]
     q_down : float or None
         Process-noise density of the down axis [m²/s³], > 0; None (FMU: 0) = ``q`` as the
         paper. Beyond the paper: an attitude error ε puts g·ε into the horizontal a_n but only
         g·ε²/2 (plus the horizontal specific force times ε) into the vertical one, so the down
-        axis can trust the accelerometer more. [``q_down``]
+        axis can trust the accelerometer more. The default 1e-4 is the best of the
+        benchmark's grid (part ``defaults``, docs/decisions/gnss-fusion-defaults.md) and of the
+        ``system`` scenario's. [``q_down``]
     r : float
-        GNSS position noise of eq. 17, R = r/Δt [m²·s], > 0. The defaults q = 0.005,
-        r = 1e-5 (at Δt = 0.01 s, R = (3 cm)²) are the best of a 3 × 3 grid on experiment (b)
-        of :mod:`marinefmu.papers.paper001` (1 Hz RTK, 300 s;
-        docs/decisions/gnss-fusion-filter.md): the ratio q/r sets the blend, and r = σ²Δt
-        (R = σ²) weights 1 Hz fixes too much against 100 Hz predictions. [``r``]
+        GNSS position noise of eq. 17, R = r/Δt [m²·s], > 0, Δt the accelerometer interval.
+        With ``noise_sizing="auto"`` the value for a receiver at 1 Hz (:data:`FIX_INTERVAL_REF`)
+        with antenna noise :data:`SIGMA_REF` (1 cm, 1.5 cm), scaled to the receiver's measured
+        rate and noise; with ``"fixed"`` R = r/Δt as given. The default 1e-5 (at Δt = 0.01 s
+        and 1 Hz, R = (3 cm)²) is the best of a 3 × 3 grid with q on experiment (b) of
+        :mod:`marinefmu.papers.paper001` (1 Hz RTK, 300 s; docs/decisions/gnss-fusion-filter.md):
+        the ratio q/(R·T) sets the blend, T the interval between fixes, and R = σ² weights the
+        fixes too much against 100 Hz predictions. [``r``]
+    noise_sizing : {"auto", "fixed"}
+        ``"auto"``: R is sized from the data as the filter runs,
+        R = r · (T_ref/T̂) · (m̂/m_ref) / Δt, T̂ the median interval between GNSS epochs and
+        m̂/m_ref the antenna-fit residual's mean square over its expectation at the reference
+        noise (:meth:`GnssAccFusion._sized_r`; one receiver, ``attitude="input"``: the rate
+        only), so that a 1 Hz and a 5 Hz receiver, or a noisier one, get the R of the same
+        blend per unit time. ``"fixed"``: R = r/Δt. [``noise_sizing``]
     attitude_correction : bool
         Rotate the specific force with the attitude (True) or take the sensor axes as NED
         (the paper's uncorrected case). [``attitude_correction``]
@@ -266,8 +302,8 @@ class GnssAccFusionParams:
 
     antennas: tuple = DEFAULT_ANTENNAS
     acc_lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    q: float = 0.005
-    q_down: float | None = None
+    q: float = 1e-3
+    q_down: float | None = 1e-4
     r: float = 1e-5
     attitude_correction: bool = True
     propagation: str = "gyro"
@@ -293,10 +329,12 @@ class GnssAccFusionParams:
     gyro_noise: float = 5e-5
     attitude: str = "antennas"
     attitude_lag: float = 0.0
+    noise_sizing: str = "auto"
     arms: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         check_choice("attitude", self.attitude, ATTITUDE_CHOICES)
+        check_choice("noise_sizing", self.noise_sizing, NOISE_SIZINGS)
         if len(self.antennas) != ANTENNAS:
             raise ParameterError(f"antennas: expected {ANTENNAS} lever arms ant1..ant4, got {len(self.antennas)}")
         arms = np.array([check_vector(f"ant{i + 1}.{{x,y,z}}", a, unit="m") for i, a in enumerate(self.antennas)])
@@ -445,6 +483,29 @@ def process_noise(dt: float, q: float, bias_rw: float | None, q_down: float | No
     return out
 
 
+def residual_ms(arms: np.ndarray, sigma_h: float, sigma_v: float) -> float:
+    """Expected square of the RMS antenna-fit residual [m²] (the mean over the antennas of the
+    squared 3-D residual, :func:`~.antenna_attitude.antenna_attitude`) for independent antenna
+    errors of ``sigma_h`` (north, east) and ``sigma_v`` (down) [m], at level attitude, to
+    first order: E = tr((I − P) Σ) / N, P the projection onto the fit's six directions (the
+    COG's three and the attitude's, antenna i moving by −[r_i]× θ, r_i the centred arm) and
+    Σ the antennas' noise covariance, N the number of antennas. With the default antennas
+    (coplanar, level) five horizontal and one vertical degrees of freedom are left:
+    (5 σ_h² + σ_v²) / 4.
+
+    Examples
+    --------
+    >>> round(residual_ms(np.array(DEFAULT_ANTENNAS), 0.01, 0.015) / 1e-4, 6)  # (5 + 2.25)/4 cm²
+    1.8125
+    """
+    arms = np.asarray(arms, dtype=float)
+    n = len(arms)
+    jac = np.vstack([np.hstack((np.eye(3), -skew(r))) for r in arms - arms.mean(axis=0)])
+    proj = jac @ np.linalg.pinv(jac)
+    sigma2 = np.tile([sigma_h ** 2, sigma_h ** 2, sigma_v ** 2], n)
+    return float(np.sum((1.0 - np.diag(proj)) * sigma2) / n)
+
+
 def receiver_params(params: GnssAccFusionParams) -> GnssAccFusionParams:
     """The parameters the filter runs with for ``attitude="input"`` (module docstring, item 5).
 
@@ -516,6 +577,14 @@ class GnssAccFusion:
         self.coast_attitude = self.coaster is not None and p.attitude_correction
         self.fix_interval = math.inf  # usual interval between accepted fixes [s] (HOLD_OVERDUE)
         self.since_pseudo = 0.0  # time since the last wave-model pseudo-fix [s]
+        # noise_sizing="auto" (_sized_r): the last intervals between epochs [s], whether an
+        # epoch has been seen, the running mean of the fit residual's square [m²] and its count
+        self.intervals: list[float] = []
+        self.epochs_seen = False
+        self.noise_ms = 0.0
+        self.noise_count = 0
+        self.r_used = self.params.r  # the r of the latest epoch [m²·s]
+        self.residual_ref = residual_ms(p.arms, *SIGMA_REF)
         self.coast_var: np.ndarray | None = None  # coast position variance at the last pseudo-fix [m²]
         self.coast_track: np.ndarray | None = None  # mean square of the pseudo-fix innovations [m²]
         # the covariance of the error as the filter runs, for pos_std outside gaps
@@ -697,7 +766,7 @@ class GnssAccFusion:
         restart = not self.initialised or self.since_fix > p.max_coast
         rot_arm = sol.rot if p.propagation == "hold" or restart else quat_to_rot(self.q)
         z = sol.centroid + rot_arm @ arm
-        r_meas = np.eye(3) * (p.r / dt)  # eq. 17
+        r_meas = np.eye(3) * (self._sized_r(gap, sol.residual) / dt)  # eq. 17
         if restart:
             gap_s, first = self.since_fix, not self.initialised
             bridged = not first and self.since_pseudo <= p.max_coast
@@ -747,6 +816,42 @@ class GnssAccFusion:
         self.since_fix = 0.0
         self.rejecting = 0.0
         return "accepted", None
+
+    def _sized_r(self, gap: float, residual: float) -> float:
+        """The r of eq. 17 for this epoch [m²·s]: ``r`` itself (``noise_sizing="fixed"``), or
+        sized from the data (``"auto"``):
+
+        r_k = r · (T_ref / T̂) · clip(m̂ / m_ref, :data:`NOISE_FACTOR_RANGE`),
+
+        with T̂ the median of the last :data:`INTERVAL_MEMORY` intervals between GNSS epochs
+        [s] (T_ref = :data:`FIX_INTERVAL_REF` until one is seen), m̂ the running mean of the
+        antenna-fit residual's square (:attr:`~.antenna_attitude.AntennaFix.residual`², the
+        mean over the antennas of the squared 3-D residual) over the last
+        :data:`NOISE_MEMORY` usable epochs, and m_ref its expectation at the reference noise
+        :data:`SIGMA_REF` (:func:`residual_ms`). Why: R·T, the fix noise per unit time, sets
+        the blend of fixes and accelerometer, so a receiver ``k`` times faster with the same
+        noise gets R ``k`` times larger (``r`` = 1e-5 at 1 Hz, 5e-5 at 5 Hz; the system
+        scenario's best was 4.5e-5 there), and a receiver ``s`` times noisier in variance
+        gets R ``s`` times larger. With one receiver (``attitude="input"``) the fit has no
+        residual: the noise factor is 1. The intervals are those of ``gap``, the time since
+        the previous epoch [s] (the first epoch's is not an interval), ``residual`` this
+        epoch's [m].
+        """
+        p = self.params
+        if p.noise_sizing == "fixed":
+            self.r_used = p.r
+            return p.r
+        if self.epochs_seen:
+            self.intervals = (self.intervals + [gap])[-INTERVAL_MEMORY:]
+        self.epochs_seen = True
+        interval = float(np.median(self.intervals)) if self.intervals else FIX_INTERVAL_REF
+        factor = 1.0
+        if p.attitude == "antennas":
+            self.noise_count = min(self.noise_count + 1, NOISE_MEMORY)
+            self.noise_ms += (residual ** 2 - self.noise_ms) / self.noise_count
+            factor = min(max(self.noise_ms / self.residual_ref, NOISE_FACTOR_RANGE[0]), NOISE_FACTOR_RANGE[1])
+        self.r_used = p.r * FIX_INTERVAL_REF / max(interval, 1e-6) * factor
+        return self.r_used
 
     def _coast_gyro(self) -> bool:
         """The coast corrects its acceleration with its own gyro attitude (a correction, a band
@@ -869,6 +974,8 @@ class GnssAccFusion:
             "coaster": None if self.coaster is None else self.coaster.get_state(),
             "error": self.error.get_state(),
             "angles": None if self.angles is None else self.angles.tolist(),
+            "intervals": list(self.intervals), "epochs_seen": self.epochs_seen,
+            "noise_ms": self.noise_ms, "noise_count": self.noise_count, "r_used": self.r_used,
         }
 
     def set_state(self, s: dict) -> None:
@@ -890,3 +997,7 @@ class GnssAccFusion:
             self.coaster.set_state(s["coaster"])
         self.error.set_state(s["error"])
         self.angles = None if s.get("angles") is None else np.array(s["angles"])
+        self.intervals = [float(x) for x in s.get("intervals", [])]
+        self.epochs_seen = bool(s.get("epochs_seen", False))
+        self.noise_ms, self.noise_count = float(s.get("noise_ms", 0.0)), int(s.get("noise_count", 0))
+        self.r_used = float(s.get("r_used", self.params.r))
