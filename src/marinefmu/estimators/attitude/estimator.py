@@ -292,8 +292,7 @@ class AttitudeEstimator:
                             + [p.gyro_bias_sigma ** 2] * 2)
         self.kf.H = np.hstack((np.eye(4), np.zeros((4, 4))))
         self.kf.R = np.diag([p.pos_sigma ** 2] * 2 + [p.vel_sigma ** 2] * 2)
-        self._q_diag = np.diag([0.0, 0.0] + [p.acc_noise ** 2] * 2 + [p.gyro_noise ** 2] * 2
-                               + [2.0 * p.gyro_bias_sigma ** 2 / p.gyro_bias_tau] * 2)
+        self._q_diag = np.diag([0.0, 0.0] + [p.acc_noise ** 2] * 2 + [0.0] * 4)  # gyro entries below
         # auto sizing: the leaky integrator and its running statistics
         self.acc_mean: np.ndarray | None = None
         self.leak_v = np.zeros(2)
@@ -307,6 +306,7 @@ class AttitudeEstimator:
         self.d2_time = 0.0
         self.gyro_noise_used = p.gyro_noise
         self.gyro_bias_sigma_used = p.gyro_bias_sigma
+        self._set_gyro_process_noise()
 
     # ---- step ---------------------------------------------------------------------------------
     def step(self, gyro: Any, acc: Any, dt: float) -> AttitudeResult:
@@ -415,11 +415,11 @@ class AttitudeEstimator:
         over the three axes (module docstring); exponential, time constant :data:`STATS_TAU`,
         start-corrected by its weight."""
         hist = self.gyro_hist
-        hist.append(gyro)
-        if len(hist) < 3:
+        if len(hist) < 2:
+            hist.append(gyro)
             return
-        d = hist[2] - 2.0 * hist[1] + hist[0]
-        del hist[0]
+        d = gyro - 2.0 * hist[1] + hist[0]
+        hist[0], hist[1] = hist[1], gyro
         beta = dt / STATS_TAU
         self.ms_d2 += beta * (float(d @ d) / 3.0 - self.ms_d2)
         self.d2_weight += beta * (1.0 - self.d2_weight)
