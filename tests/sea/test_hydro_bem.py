@@ -155,9 +155,9 @@ def test_bad_input_is_refused_naming_it(kwargs, match):
         bem.solve(hull, args.pop("mass"), args.pop("omega"), np.array([math.pi]), progress=False, **args)
 
 
-@pytest.mark.parametrize("radii", [(0.0, 1.0, 1.0), (1.0, -1.0, 1.0)])
+@pytest.mark.parametrize("radii", [(0.0, 1.0, 1.0), (1.0, -1.0, 1.0), (1.0, 1.0, 0.0), (1.0, 1.0, math.inf)])
 def test_non_positive_inertia_is_refused(radii):
-    with pytest.raises(ParameterError, match=r"hull\.radii\.[xy]"):
+    with pytest.raises(ParameterError, match=r"hull\.radii(\.[xyz])?"):
         MassProperties(cog=(0.0, 0.0, 0.0), radii=radii)
 
 
