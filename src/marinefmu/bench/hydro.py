@@ -4,7 +4,10 @@ motion changes for the estimators.
 - **Presets** (:func:`solve_presets`): each BEM preset (:data:`marinefmu.sea.hydro.presets.BEM_PRESETS`)
   solved by Capytaine at its shipped resolution: panels, frequencies, wall time (goal ≤ 5 min
   each on the 2-core machine), natural periods, peak RAOs, and the largest difference from the
-  shipped CSV (0 when the shipped tables are current).
+  shipped CSV (0 when the shipped tables are current), and the largest deviation of the damping
+  from the Haskind-Newman relation (:func:`marinefmu.sea.hydro.validation.haskind_deviation`).
+- **Grid cover** (:func:`grid_cover`): for each shipped table and benchmark sea, the bound on the
+  heave, roll and pitch above the table's last frequency (:func:`marinefmu.sea.hydro.validation.tail_bound`).
 - **Closed form against BEM** (:func:`compare_presets`): natural periods and peak RAOs of each
   closed-form preset beside its BEM counterpart.
 - **Estimators on BEM motion** (:func:`estimator_errors`): the AttitudeEstimator and the
@@ -38,7 +41,7 @@ def solve_presets(out_dir: Path | None = None, names: tuple[str, ...] | None = N
         Per preset: :func:`marinefmu.sea.hydro.export.summary` plus ``wall_s`` and
         ``max_diff_shipped`` (largest |ΔRAO| against the shipped CSV, m/m or rad/m).
     """
-    from ..sea.hydro import bem, export, presets
+    from ..sea.hydro import bem, export, presets, validation
     from ..sea.vessel import bem_preset_path, load_rao_csv
 
     out = {}
@@ -52,6 +55,10 @@ def solve_presets(out_dir: Path | None = None, names: tuple[str, ...] | None = N
         wall = time.perf_counter() - t0
         s = export.summary(r)
         s["wall_s"] = round(wall, 1)
+        v = hull.full()[0]                              # solver frame: y to port, so body y = −v_y
+        radius = float(np.max(np.hypot(v[:, 0] - r.cog[0], -v[:, 1] - r.cog[1])))
+        s["haskind_omega_max"] = min(float(r.omega[-1]), validation.haskind_omega_limit(r, radius))
+        s["haskind_deviation"] = validation.haskind_deviation(r, s["haskind_omega_max"])
         shipped = bem_preset_path(name)
         if shipped.exists():
             old = load_rao_csv(shipped)
@@ -63,8 +70,43 @@ def solve_presets(out_dir: Path | None = None, names: tuple[str, ...] | None = N
         t = r.natural_periods
         print(f"hydro {name}: {r.panels} panels, {r.omega.size} frequencies × (6 + {r.heading.size}) problems in {wall:.0f} s; "
               f"T heave / roll / pitch {t['heave']:.2f} / {t['roll']:.2f} / {t['pitch']:.2f} s; "
-              f"max |ΔRAO| against the shipped table {s.get('max_diff_shipped')}", flush=True)
+              f"max |ΔRAO| against the shipped table {s.get('max_diff_shipped')}; Haskind-Newman deviation "
+              f"(ω ≤ {s['haskind_omega_max']:.2f} rad/s) "
+              + ", ".join(f"{d} {v:.3f}" for d, v in s["haskind_deviation"].items()), flush=True)
         out[name] = s
+    return out
+
+
+def grid_cover() -> dict[str, dict]:
+    """Bound on the motion above each shipped table's last frequency in each benchmark sea.
+
+    Returns
+    -------
+    dict
+        ``{preset: {"Hs/Tp": {dof: {"lost_std", "lost_fraction", "kept_std"}}}}`` for heave
+        [m], roll and pitch [deg], each at its :data:`~marinefmu.sea.hydro.export.PEAK_HEADING_DEG`.
+    """
+    from ..sea.hydro.export import PEAK_HEADING_DEG
+    from ..sea.hydro.presets import BEM_PRESETS
+    from ..sea.hydro.validation import tail_bound
+    from ..sea.vessel import bem_preset_path, load_rao_csv
+    from ..sea.waves import SeaState
+    from .defaults import SEAS
+
+    out: dict[str, dict] = {}
+    for name in BEM_PRESETS:
+        table = load_rao_csv(bem_preset_path(name))
+        for hs, tp in SEAS:
+            row = {}
+            for dof in ("heave", "roll", "pitch"):
+                d = tail_bound(table, SeaState(hs=hs, tp=tp), math.radians(PEAK_HEADING_DEG[dof]))[dof]
+                scale = 1.0 if dof == "heave" else math.degrees(1.0)
+                row[dof] = {"kept_std": scale * d["kept_std"], "lost_std": scale * d["lost_std"],
+                            "lost_fraction": d["lost_fraction"]}
+            out.setdefault(name, {})[f"{hs:g}/{tp:g}"] = row
+            print(f"hydro grid cover {name} Hs {hs:g} Tp {tp:g}: lost above {table.omega[-1]:g} rad/s ≤ "
+                  + ", ".join(f"{d} {v['lost_std']:.2g} ({100 * v['lost_fraction']:.2g} %)" for d, v in row.items()),
+                  flush=True)
     return out
 
 
@@ -155,8 +197,8 @@ def estimator_errors(pairs: dict[str, str] | None = None) -> dict[str, dict]:
 def hydro_bench(out_dir: Path) -> dict:
     """The whole part: presets (tables and plots into ``out_dir/hydro``), comparison, estimators."""
     solved = solve_presets(out_dir / "hydro")
-    return {"presets": solved, "closed_form_vs_bem": compare_presets(solved), "sea": SEA,
-            "estimators": estimator_errors()}
+    return {"presets": solved, "closed_form_vs_bem": compare_presets(solved), "grid_cover": grid_cover(),
+            "sea": SEA, "estimators": estimator_errors()}
 
 
 if __name__ == "__main__":  # python -m marinefmu.bench.hydro: the part alone, printed

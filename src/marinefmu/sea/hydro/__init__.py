@@ -12,7 +12,9 @@ written as the RAO CSV that ``vessel.rao_file`` reads.
   with optional viscous roll damping, natural periods;
 - :mod:`~marinefmu.sea.hydro.export`: the RAO table in the project's frames and phase
   convention, the CSV file and the plot of the six RAOs;
-- :mod:`~marinefmu.sea.hydro.presets`: the BEM presets shipped under ``marinefmu/data/hydro``.
+- :mod:`~marinefmu.sea.hydro.presets`: the BEM presets shipped under ``marinefmu/data/hydro``;
+- :mod:`~marinefmu.sea.hydro.validation`: the Haskind-Newman check of a result and the bound on
+  the motion above a table's last frequency.
 
 Capytaine is an optional dependency (``pip install marinefmu[hydro]``) imported only inside
 the functions that solve or read meshes, never at module import; VesselMotion and the FMUs read
