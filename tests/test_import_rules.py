@@ -6,7 +6,7 @@ also one inside a function or under ``TYPE_CHECKING``):
   FMUs, run systems or use the models (``fmu``, ``cosim``, ``analysis``, ``bench``, ``campaign``,
   ``papers``, ``cli``), so that a model can be used, tested and benchmarked without them;
 - an estimator package imports only the shared modules (``frames``, ``errors``,
-  ``estimators.numerics``, ``.samples``, ``.protocol``) and itself; the GNSS fusion's wave coast
+  ``estimators.numerics``, ``.samples``, ``.protocol``, ``.noise_meter``) and itself; the GNSS fusion's wave coast
   (``estimators.gnss_fusion.wave_coast`` and its band observer ``.aided_band``) may also use
   paper 003's observer and its oscillator bank (``estimators.heave``), which it runs on the
   fusion's own acceleration during a GNSS dropout;
@@ -28,7 +28,7 @@ SRC = Path(marinefmu.__file__).resolve().parent
 PACKAGE = "marinefmu"
 
 SHARED = ("marinefmu.frames", "marinefmu.errors", "marinefmu.estimators.numerics", "marinefmu.estimators.samples",
-          "marinefmu.estimators.protocol")
+          "marinefmu.estimators.protocol", "marinefmu.estimators.noise_meter")
 ESTIMATOR_PACKAGES = ("attitude", "reconstruction", "gnss_fusion", "centre_of_rotation", "heave")
 # module -> packages it may import beyond the shared modules and its own package
 ALLOWED_BEYOND = {"marinefmu.estimators.gnss_fusion.wave_coast": ("marinefmu.estimators.heave",),

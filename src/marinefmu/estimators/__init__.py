@@ -16,5 +16,6 @@ package                          estimates                                    pa
 ================================ ============================================ ==========
 
 Shared by them: :mod:`.numerics` (direct integration, single-thread BLAS), :mod:`.samples`
-(plausibility limits of single IMU samples) and :mod:`.protocol` (the estimator pattern).
+(plausibility limits of single IMU samples), :mod:`.noise_meter` (a sensor's white noise from
+its second difference) and :mod:`.protocol` (the estimator pattern).
 """

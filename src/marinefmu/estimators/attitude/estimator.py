@@ -95,6 +95,7 @@ from filterpy.kalman import KalmanFilter
 
 from ...errors import check_choice, check_int, check_range, check_vector
 from ...frames import euler_to_quat, level_angles, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
+from ..noise_meter import WhiteNoiseMeter
 from ..samples import force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
@@ -299,11 +300,8 @@ class AttitudeEstimator:
         self.ms_v = np.zeros(2)
         self.stats_weight = 0.0
         self.stats_time = 0.0
-        # auto sizing of the gyro noise: the last two good samples and the running mean of d²
-        self.gyro_hist: list[np.ndarray] = []
-        self.ms_d2 = 0.0
-        self.d2_weight = 0.0
-        self.d2_time = 0.0
+        # auto sizing of the gyro noise: the running mean of its second difference
+        self.gyro_meter = WhiteNoiseMeter(STATS_TAU)
         self.gyro_noise_used = p.gyro_noise
         self.gyro_bias_sigma_used = p.gyro_bias_sigma
         self._set_gyro_process_noise()
@@ -335,9 +333,9 @@ class AttitudeEstimator:
             if self.last_gyro is None:
                 return self._result(False, warning)
             gyro, acc = self.last_gyro, self.last_acc
-            self.gyro_hist.clear()  # a second difference spans consecutive good samples only
+            self.gyro_meter.break_chain()  # a second difference spans consecutive good samples only
         elif self.params.aid_sizing == "auto":
-            self._gyro_statistics(gyro, dt)
+            self.gyro_meter.push(gyro, dt)
         w_prev = gyro if self.last_gyro is None else self.last_gyro
         omega = 0.5 * (w_prev + gyro) - self.bias
         self.last_gyro, self.last_acc = gyro, acc
@@ -386,7 +384,7 @@ class AttitudeEstimator:
             if p.aid_sizing == "auto" and self.stats_time >= LEAK_TAU:
                 sigma_v = np.maximum(SIGMA_V_MIN, AID_GAIN * np.sqrt(self.ms_v / self.stats_weight))
                 kf.R = np.diag(np.concatenate(((POS_RATIO * sigma_v) ** 2, sigma_v ** 2)))
-            if p.aid_sizing == "auto" and self.d2_time >= NOISE_SETTLE:
+            if p.aid_sizing == "auto" and self.gyro_meter.time >= NOISE_SETTLE:
                 self._size_gyro_noise(dt)
             kf.update(np.concatenate((self.pos, self.vel)))
             dx = kf.x.ravel()
@@ -410,26 +408,11 @@ class AttitudeEstimator:
         self.stats_weight += beta * (1.0 - self.stats_weight)
         self.stats_time += dt
 
-    def _gyro_statistics(self, gyro: np.ndarray, dt: float) -> None:
-        """Running mean of the squared second difference of the good gyro samples [(rad/s)²],
-        over the three axes (module docstring); exponential, time constant :data:`STATS_TAU`,
-        start-corrected by its weight."""
-        hist = self.gyro_hist
-        if len(hist) < 2:
-            hist.append(gyro)
-            return
-        d = gyro - 2.0 * hist[1] + hist[0]
-        hist[0], hist[1] = hist[1], gyro
-        beta = dt / STATS_TAU
-        self.ms_d2 += beta * (float(d @ d) / 3.0 - self.ms_d2)
-        self.d2_weight += beta * (1.0 - self.d2_weight)
-        self.d2_time += dt
-
     def _size_gyro_noise(self, dt: float) -> None:
-        """The gyro's white-noise density and bias σ from :meth:`_gyro_statistics` into the
+        """The gyro's white-noise density and bias σ from its second difference into the
         process noise (module docstring)."""
         p = self.params
-        n_hat = math.sqrt(self.ms_d2 / self.d2_weight * dt / 6.0)
+        n_hat = self.gyro_meter.density(dt)
         self.gyro_noise_used = max(GYRO_NOISE_MIN, n_hat)
         self.gyro_bias_sigma_used = p.gyro_bias_sigma * self.gyro_noise_used / p.gyro_noise
         self._set_gyro_process_noise()
@@ -457,8 +440,7 @@ class AttitudeEstimator:
             "acc_mean": None if self.acc_mean is None else self.acc_mean.tolist(),
             "leak_v": self.leak_v.tolist(), "ms_v": self.ms_v.tolist(),
             "stats_weight": self.stats_weight, "stats_time": self.stats_time,
-            "gyro_hist": [g.tolist() for g in self.gyro_hist], "ms_d2": self.ms_d2, "d2_weight": self.d2_weight,
-            "d2_time": self.d2_time, "gyro_noise_used": self.gyro_noise_used,
+            "gyro_meter": self.gyro_meter.get_state(), "gyro_noise_used": self.gyro_noise_used,
             "gyro_bias_sigma_used": self.gyro_bias_sigma_used,
         }
 
@@ -477,8 +459,7 @@ class AttitudeEstimator:
         self.acc_mean = None if s["acc_mean"] is None else np.array(s["acc_mean"])
         self.leak_v, self.ms_v = np.array(s["leak_v"]), np.array(s["ms_v"])
         self.stats_weight, self.stats_time = float(s["stats_weight"]), float(s["stats_time"])
-        self.gyro_hist = [np.array(g) for g in s["gyro_hist"]]
-        self.ms_d2, self.d2_weight, self.d2_time = float(s["ms_d2"]), float(s["d2_weight"]), float(s["d2_time"])
+        self.gyro_meter.set_state(s["gyro_meter"])
         self.gyro_noise_used, self.gyro_bias_sigma_used = float(s["gyro_noise_used"]), float(s["gyro_bias_sigma_used"])
         self._set_gyro_process_noise()
 
