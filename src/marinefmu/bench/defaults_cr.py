@@ -51,6 +51,8 @@ CR_GRID: tuple[dict, ...] = (
     {"hp_cutoff": 0.002},
     {"offset_rw": 1e-4},
     {"acc_sigma": 0.1},
+    {"diff_sizing": "fixed"},
+    {"diff_sizing": "fixed", "diff_window": 3.0},
 )
 
 
@@ -106,7 +108,7 @@ def cr_case(preset: str, hs: float, tp: float, place: str, grid: tuple[dict, ...
 
 
 def _label(setting: dict) -> str:
-    return ",".join(f"{k}={v:g}" for k, v in setting.items())
+    return ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in setting.items())
 
 
 def print_cr(rows: list[dict]) -> dict:

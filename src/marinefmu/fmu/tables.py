@@ -12,6 +12,7 @@ from typing import Any
 
 from ..estimators.attitude.estimator import AID_SIZINGS, INIT_CHOICES, AttitudeEstimatorParams
 from ..estimators.centre_of_rotation.filter import ANGLE_CHOICES as CR_ANGLE_CHOICES
+from ..estimators.centre_of_rotation.filter import DIFF_SIZINGS as CR_DIFF_SIZINGS
 from ..estimators.centre_of_rotation.filter import CentreOfRotationParams
 from ..estimators.heave.band_bank import BAND_VARIANCES
 from ..estimators.heave.common import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
@@ -192,7 +193,8 @@ _CR = CentreOfRotationParams()
 CR_PARAMETERS: list[Variable] = [
     Variable("angles", "string", _CR.angles, "", f"Angle source: one of {', '.join(CR_ANGLE_CHOICES)} (high-pass integrated gyro as paper 002, or the roll/pitch/yaw inputs)"),
     real("hp_cutoff", _CR.hp_cutoff, "Hz", "Cutoff of the high-pass angle integration (paper 002 section 3.2), (0, 1]"),
-    real("diff_window", _CR.diff_window, "s", "Savitzky-Golay window for the angular acceleration, (0, 10]; outputs lag by half of it"),
+    real("diff_window", _CR.diff_window, "s", "Savitzky-Golay window for the angular acceleration, (0, 10]; outputs lag by half of it; with diff_sizing = auto the window it starts with"),
+    Variable("diff_sizing", "string", _CR.diff_sizing, "", f"Differentiation window: one of {', '.join(CR_DIFF_SIZINGS)} (sized from the gyro noise and the rotation as it runs, or diff_window throughout)"),
     Variable("centripetal", "boolean", _CR.centripetal, "", "Lever-arm term alpha x o + omega x (omega x o) (false: the paper's alpha x o)"),
     real("acc_sigma", _CR.acc_sigma, "m/s2", "Measurement noise of one specific-force sample, (0, 10]"),
     real("acc_rw", _CR.acc_rw, "m/s2/sqrt(s)", "Random-walk density of the CR acceleration states (paper 002 eq. 1), (0, 100]"),
@@ -230,7 +232,8 @@ def cr_params(values: dict[str, Any]) -> CentreOfRotationParams:
     """CentreOfRotationParams from FMI-named values."""
     v = resolve(CR_PARAMETERS, values, "CentreOfRotation")
     return CentreOfRotationParams(
-        angles=v["angles"], hp_cutoff=v["hp_cutoff"], diff_window=v["diff_window"], centripetal=bool(v["centripetal"]),
+        angles=v["angles"], hp_cutoff=v["hp_cutoff"], diff_window=v["diff_window"], diff_sizing=v["diff_sizing"],
+        centripetal=bool(v["centripetal"]),
         acc_sigma=v["acc_sigma"], acc_rw=v["acc_rw"], offset_rw=v["offset_rw"], offset_sigma0=v["offset_sigma0"],
         settle_time=v["settle_time"], sensor=(v["sensor.x"], v["sensor.y"], v["sensor.z"]),
     )

@@ -109,8 +109,10 @@ def angle_errors(seed: int = 7, sensor: str = "bridge", duration: float = DURATI
 
     def add(label: str, angles: np.ndarray | None, **params) -> None:
         r = estimate(rec, arm, angles, **params)
-        d = int(round(r["delay"] / DT))
-        used = r["euler"][d:, :2] - euler[: len(euler) - d, :2]
+        k = np.arange(len(euler))
+        at = k - np.round(r["delay"] / DT).astype(int)       # the sample each row refers to
+        ok = r["valid"] & (at >= 0)
+        used = r["euler"][ok, :2] - euler[at[ok], :2]
         rms = math.degrees(float(np.sqrt(np.mean(used[len(used) // 10:] ** 2))))
         rows.append((label, rms, *(r["offset"][-1] - ref)))
 

@@ -13,7 +13,10 @@ from marinefmu.estimators.centre_of_rotation.filter import (
     CentreOfRotation, CentreOfRotationParams, eq11_specific_force, leaky_angle_step, lever_matrix,
     predicted_specific_force,
 )
-from marinefmu.estimators.centre_of_rotation.centred_window import CentredWindow
+from marinefmu.estimators.centre_of_rotation import filter as cr_filter
+from marinefmu.estimators.centre_of_rotation.centred_window import (
+    CentredWindow, derivative_gain_error, derivative_increment_gain, derivative_noise_gain, window_samples,
+)
 from marinefmu.papers import paper002
 from marinefmu.frames import G, attitude_kinematics, body_to_euler_rates, euler_rates_to_body, rot_nb
 
@@ -99,6 +102,78 @@ def test_savgol_derivative_is_exact_for_a_quartic():
     assert out[0][0] == x(tc) and win.delay == pytest.approx(0.15)
 
 
+def test_derivative_noise_and_loss_kernels():
+    """Σd² and Σ(Δd)² against seeded white noise (2 % at 200,000 samples), the loss against the
+    derivative of a sampled sine."""
+    dt, n = 0.01, window_samples(2.0, 0.01, 4)
+    noise = np.random.default_rng(5).normal(0.0, 1.0, 200_000)
+    w = CentredWindow(1, n, dt, 4)
+    d = np.array([out[2][0] for x in noise if (out := w.push([x])) is not None])
+    assert np.var(d) == pytest.approx(derivative_noise_gain(n, dt, 4), rel=0.02)
+    assert np.var(np.diff(d)) == pytest.approx(derivative_increment_gain(n, dt, 4), rel=0.02)
+    omega = 2 * math.pi * 0.25
+    w = CentredWindow(1, n, dt, 4)
+    outs = [w.push([math.sin(omega * k * dt)]) for k in range(n)]
+    tc = (n // 2) * dt
+    assert outs[-1][2][0] == pytest.approx((1 - derivative_gain_error(n, dt, 4, omega)) * omega * math.cos(omega * tc),
+                                           rel=1e-9)
+    assert derivative_gain_error(n, dt, 4, 0.0) == 0.0
+    assert 0 < derivative_gain_error(n, dt, 4, 0.5 * omega) < derivative_gain_error(n, dt, 4, omega) < 0.1
+
+
+def _noisy_rotation(n, start=0, gyro_noise=5e-5, dt=0.01):
+    """A slow small rotation (0.1 Hz, α ≈ 4e-3 rad/s²) sensed by a gyro of white-noise density
+    ``gyro_noise`` [rad/s/√Hz] and a noiseless accelerometer: the noise dominates Δα."""
+    rng = np.random.default_rng(11 + start)
+    for k in range(start, start + n):
+        t = (k + 1) * dt
+        gyro = np.array([0.006 * math.sin(0.63 * t), 0.004 * math.cos(0.55 * t), 0.001 * math.sin(0.4 * t)])
+        yield [0.05 * math.sin(0.6 * t), 0.04 * math.cos(0.5 * t), -G], gyro + rng.normal(0, gyro_noise / math.sqrt(dt), 3)
+
+
+def test_auto_window_grows_when_gyro_noise_dominates_and_survives_a_state_round_trip():
+    est = CentreOfRotation()
+    for acc, gyro in _noisy_rotation(5_900):
+        est.step(acc, gyro, 0.01)
+    assert est.window_s == 1.5                      # sized only after 60 s filtered
+    saved = est.get_state()
+    rest = [est.step(acc, gyro, 0.01) for acc, gyro in _noisy_rotation(1_000, start=5_900)]
+    assert est.window_s > 3.0 and est.window.n == window_samples(est.window_s, 0.01, 4)
+    assert rest[-1].delay == pytest.approx(est.window.delay)
+    # the centre moved back: the samples it passes again are not filtered twice (valid false)
+    assert any(not r.valid for r in rest[200:]) and rest[-1].valid
+    other = CentreOfRotation()
+    other.set_state(saved)
+    assert [other.step(acc, gyro, 0.01) for acc, gyro in _noisy_rotation(1_000, start=5_900)] == rest
+    fixed = CentreOfRotation(CentreOfRotationParams(diff_sizing="fixed"))
+    for acc, gyro in _noisy_rotation(6_300):
+        fixed.step(acc, gyro, 0.01)
+    assert fixed.window_s == 1.5 and fixed.window.n == window_samples(1.5, 0.01, 4)
+
+
+def test_auto_window_brings_a_far_imu_on_a_large_ship_near_the_floor():
+    """polar_supply, Hs 3 m / Tp 10 s, IMU 51 m from the CR, MEMS gyro, 600 s: the 1.5 s window
+    leaves the final estimate 6.0 m above the record's floor (the gyro noise in α pulls it to the
+    sensor; docs/decisions/centre-of-rotation-defaults.md); the window sized from the data
+    (3-4 s here) leaves 0.63 m. Limit 0.8 m."""
+    from marinefmu.bench.defaults import case_record, placements
+    from marinefmu.bench.defaults_cr import CR, cr_errors
+    sensor = placements("polar_supply")["far"]
+    rec = case_record("polar_supply", 3.0, 10.0, "far",
+                      extra={"vessel.mode": 1, **{f"vessel.cr.{a}": v for a, v in zip("xyz", CR)}})
+    r = cr_errors(rec, sensor, paper002.truth_floor(rec, sensor))
+    assert r["valid"] > 0.99
+    assert r["merit"] < 0.8, r
+
+
+def test_auto_window_stays_short_for_a_clean_gyro():
+    """Without gyro noise only the derivative's loss counts: the shortest window is chosen."""
+    est = CentreOfRotation()
+    for acc, gyro in _noisy_rotation(6_300, gyro_noise=0.0):
+        est.step(acc, gyro, 0.01)
+    assert est.window_s == cr_filter.WINDOW_CHOICES[0]
+
+
 # ---- against known truth (VesselMotion, vessel.mode 1, default MEMS noise, 10 minutes) ----------
 @pytest.fixture(scope="module")
 def convergence():
@@ -108,7 +183,7 @@ def convergence():
 def test_both_sensors_reach_the_floor_of_the_record(convergence):
     """The filter settles where the record's sample correlation puts any estimator of its model
     (the floor, computed from exact data): within 0.1 m per axis with MEMS noise and the
-    high-pass angles (measured 0.05 / 0.08 m in y). The floor itself is 0.5 m in y here, which is
+    high-pass angles (measured 0.06 / 0.09 m in y). The floor itself is 0.5 m in y here, which is
     why the absolute 0.1 m goal needs weaker translations (next test) or longer records."""
     for name in paper002.SENSORS:
         r = convergence[name]
@@ -117,14 +192,14 @@ def test_both_sensors_reach_the_floor_of_the_record(convergence):
 
 def test_two_sensors_on_one_rigid_body_agree(convergence):
     """The floor is the same for every sensor position, so the CR estimates agree (0.2 m goal;
-    measured 0.03 m)."""
+    measured 0.06 m)."""
     assert np.all(np.abs(convergence["agreement"]["final"]) < 0.2)
     assert np.all(np.abs(convergence["agreement"]["mean"]) < 0.2)
 
 
 def test_offset_error_below_10_cm_when_the_floor_allows():
     """Translations 20x weaker than the rotations' lever effects (floor 0.03 m): the estimate
-    is within 0.1 m of the true CR after 10 minutes with MEMS noise (measured 0.044 m)."""
+    is within 0.1 m of the true CR after 10 minutes with MEMS noise (measured 0.058 m)."""
     res = paper002.weak_translation()
     for name in paper002.SENSORS:
         assert np.all(np.abs(res[name]["error"]) < 0.1), (name, res[name])
@@ -153,6 +228,7 @@ def test_angle_errors_in_phase_with_the_motion_move_the_cr_height():
     ("hp_cutoff", -0.1, "hp_cutoff = -0.1 is out of range"),
     ("diff_window", 0.0, "diff_window = 0.0 is out of range"),
     ("angles", "gyro", "angles = 'gyro' is not allowed"),
+    ("diff_sizing", "sometimes", "diff_sizing = 'sometimes' is not allowed"),
     ("centripetal", "yes", "centripetal must be True or False"),
 ])
 def test_bad_parameters_are_refused_by_name(field, value, message):

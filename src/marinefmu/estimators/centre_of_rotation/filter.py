@@ -47,6 +47,29 @@ taken at the window centre, so the filter runs ``delay`` = diff_window/2 behind 
 sample, without phase error between α and the accelerations. The paper does not say how it
 differentiates.
 
+**Window sized from the data** (``diff_sizing = "auto"``, default). The gyro's white noise,
+differentiated into α, is an error in the regressor: it pulls the offset towards the sensor
+(errors in variables). Because the a_CR states follow the CR's acceleration within a few
+samples (``acc_rw`` against ``acc_sigma``), the offset is told apart from a_CR by what a_CR
+cannot follow, the step-to-step change of α × o; so what matters is the noise in the *change*
+of α against the change of the true α. The noise gives Δα the variance σ² Σ(Δd)²
+(:func:`.centred_window.derivative_increment_gain`, σ² = N²/dt per sample for a gyro of density
+N), falling as W⁻⁴ with the window W; the true Δα is α̇ dt. The fraction by which the noise
+shrinks offset component i is about r_i(W) = 2σ²Σ(Δd)² / (var Δα_j + var Δα_k) over the two
+other axes (measured on polar_supply, Hs 3 m, Tp 10 s, IMU 51 m from the CR: the error is
+0.3 r_x at windows of 1.5-3 s, from 6 m at 1.5 s to 0.45 m at 3 s). A longer window loses the
+fraction ε(W, ω_j) of the motion at the frequency ω_j = σ(α̇)/σ(α) that carries Δα
+(:func:`.centred_window.derivative_gain_error`), which biases the offset the other way (a
+small ship in a steep sea: research36, Hs 6 m, Tp 14 s, 0.09 m above the floor at 1.5 s and
+0.39 m at 3 s). Every :data:`SIZING_EVERY` s the estimator measures N from the gyro's second
+difference (white noise of variance σ² per sample gives 6σ² there; the wave motion adds
+(ω dt)⁴ of itself, nothing at 100 Hz), and per axis the variances of α and of Δα less the
+parts the present window's noise passes, and sets the window of :data:`WINDOW_CHOICES` that
+minimises 0.3 maxᵢ r_i(W) + 2.7 ε(W, ω_j) (the measured weights, :data:`NOISE_WEIGHT`). ``diff_window`` is the window it starts with; ``"fixed"``
+keeps it throughout (the filter as before). When the window changes, the centre moves by half
+the change: the samples between the old and the new centre are not filtered twice (a longer
+window) or are skipped (a shorter one), and ``delay`` follows.
+
 **No rotation** (a vessel in harbour): the offset is observable only through α (and ω), so
 with no rotation there is nothing to estimate it from, and a gyro's noise differentiated into α
 is then taken for rotation: it pulls the offset towards the sensor (errors in variables) and
@@ -77,12 +100,26 @@ from filterpy.kalman import KalmanFilter
 
 from ...errors import ParameterTypeError, check_choice, check_range, check_vector
 from ...frames import GRAVITY_N, G, body_to_euler_rates, rigid_point_operator, rot_nb
-from .centred_window import CentredWindow, window_samples
+from .centred_window import (CentredWindow, derivative_gain_error, derivative_increment_gain, derivative_noise_gain,
+                             window_samples)
+from ..noise_meter import WhiteNoiseMeter
 from ..samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
 
 ANGLE_CHOICES = ("gyro_hp", "input")
+DIFF_SIZINGS = ("auto", "fixed")
+#: Windows [s] the ``auto`` sizing chooses from (module docstring, "Window sized from the data").
+WINDOW_CHOICES = tuple(0.5 * k for k in range(2, 21))
+#: Interval of the ``auto`` sizing [s]; the first comes after this much filtered time.
+SIZING_EVERY = 60.0
+#: Weights of the two errors the window trades, as measured (module docstring): the offset error
+#: the noise causes is 0.3 r_x (polar_supply, Hs 3 m, Tp 10 s, IMU far, windows 1.5-3 s) and the
+#: one the window's loss causes is 2.7 ε(W, ω_j) (research36, Hs 6 m, Tp 14 s, IMU far, 3 s; more
+#: than ε at ω_j because the loss grows as ω⁴ and Δα carries the motion's upper band too).
+NOISE_WEIGHT, LOSS_WEIGHT = 0.3, 2.7
+#: Memory of the running mean squares of the gyro's second difference, of α and of Δα [s].
+NOISE_TAU = 60.0
 #: Order of the Savitzky–Golay fit. The derivative's gain error grows as (ωT)^(order): order 2
 #: over 0.5 s loses 1 % of α at 0.2 Hz (0.13 m on a 13 m offset), order 4 over the default 1.5 s
 #: loses 0.16 % at 0.2 Hz and 0.8 % at 0.3 Hz while averaging the gyro noise enough that it does
@@ -114,7 +151,11 @@ class CentreOfRotationParams:
         Cutoff of the angle high-pass [Hz], (0, 1]. [``hp_cutoff``]
     diff_window : float
         Length of the Savitzky–Golay differentiation window [s], (0, 10]; the estimator runs
-        half of it behind the newest sample. [``diff_window``]
+        half of it behind the newest sample. With ``diff_sizing = "auto"`` the window it starts
+        with. [``diff_window``]
+    diff_sizing : str
+        ``"auto"`` (default): the window is sized from the gyro's noise and the rotation as the
+        estimator runs (module docstring); ``"fixed"``: ``diff_window`` throughout. [``diff_sizing``]
     centripetal : bool
         Include ω × (ω × o) in the lever-arm term (False: the paper's α × r only). [``centripetal``]
     acc_sigma : float
@@ -136,6 +177,7 @@ class CentreOfRotationParams:
     angles: str = "gyro_hp"
     hp_cutoff: float = 0.005
     diff_window: float = 1.5
+    diff_sizing: str = "auto"
     centripetal: bool = True
     acc_sigma: float = 0.02
     acc_rw: float = 0.05
@@ -148,6 +190,7 @@ class CentreOfRotationParams:
         check_choice("angles", self.angles, ANGLE_CHOICES)
         check_range("hp_cutoff", self.hp_cutoff, lo=0.0, hi=1.0, lo_open=True, unit="Hz")
         check_range("diff_window", self.diff_window, lo=0.0, hi=10.0, lo_open=True, unit="s")
+        check_choice("diff_sizing", self.diff_sizing, DIFF_SIZINGS)
         if not isinstance(self.centripetal, (bool, np.bool_)):
             raise ParameterTypeError(f"centripetal must be True or False, got {self.centripetal!r}")
         check_range("acc_sigma", self.acc_sigma, lo=0.0, hi=10.0, lo_open=True, unit="m/s2")
@@ -389,6 +432,18 @@ class CentreOfRotation:
         self.alpha_weight = 0.0
         self.alpha_time = 0.0
         self.unobservable = False
+        # auto window sizing: the gyro's noise from its second difference; per axis the running
+        # mean squares of α [(rad/s²)²] and of its
+        # step-to-step change Δα with their weight, the last α (None after a break); the window
+        # [s] in use, the filtered time at the next sizing [s], and centre samples still to skip
+        self.gyro_meter = WhiteNoiseMeter(NOISE_TAU)
+        self.ms_alpha = np.zeros(3)
+        self.ms_dalpha = np.zeros(3)
+        self.alpha_stats_weight = 0.0
+        self.prev_alpha: np.ndarray | None = None
+        self.window_s = p.diff_window
+        self.next_sizing = SIZING_EVERY
+        self.skip = 0
         self.kf = KalmanFilter(dim_x=6, dim_z=3)
         self.kf.P = np.diag([1.0] * 3 + [p.offset_sigma0 ** 2] * 3)
         self.kf.R = np.eye(3) * p.acc_sigma ** 2
@@ -397,7 +452,11 @@ class CentreOfRotation:
     def _start(self, dt: float) -> None:
         p = self.params
         self.dt = dt
-        self.window = CentredWindow(9, window_samples(p.diff_window, dt, POLYORDER), dt, POLYORDER)
+        capacity = None
+        if p.diff_sizing == "auto":
+            capacity = max(window_samples(w, dt, POLYORDER) for w in WINDOW_CHOICES + (self.window_s,))
+        self.window = CentredWindow(9, window_samples(self.window_s, dt, POLYORDER), dt, POLYORDER, capacity)
+        self.skip = 0
         self.kf.Q = np.diag([p.acc_rw ** 2 * dt] * 3 + [p.offset_rw ** 2 * dt] * 3)
 
     def step(self, acc: Any, gyro: Any, dt: float, euler: Any = None) -> CentreOfRotationResult:
@@ -444,12 +503,23 @@ class CentreOfRotation:
             rate = gyro if prev is None else 0.5 * (gyro + prev[1])
             self.euler = leaky_angle_step(self.euler, rate.tolist(), dt, p.hp_cutoff)
             ang = np.array(self.euler)
+        if p.diff_sizing == "auto":
+            if warning is None:
+                self.gyro_meter.push(gyro, dt)
+            else:
+                self.gyro_meter.break_chain()
         centre = self.window.push(np.concatenate((gyro, acc, ang)))
         if centre is None:
+            return self._invalid(warning)
+        if self.skip > 0:
+            # the window grew: this centre sample was filtered before the change
+            self.skip -= 1
             return self._invalid(warning)
         raw, smooth, deriv = centre
         omega, alpha, f_b, angles = smooth[0:3], deriv[0:3], raw[3:6], raw[6:9].tolist()
         observable = self._excitation(alpha, dt)
+        if p.diff_sizing == "auto":
+            self._alpha_statistics(alpha if warning is None else None, dt)
         rot = rot_nb(*angles)
         kf = self.kf
         kf.predict()
@@ -466,7 +536,52 @@ class CentreOfRotation:
             self.mean_sum += kf.x[3:6, 0]
             self.mean_count += 1
         self._result = self._output(f_b, alpha, angles, warning is None and observable, warning)
+        if p.diff_sizing == "auto" and self.filtered_time >= self.next_sizing - 1e-9:
+            self.next_sizing += SIZING_EVERY
+            self._size_window(dt)
         return self._result
+
+    def _alpha_statistics(self, alpha: np.ndarray | None, dt: float) -> None:
+        """Running mean squares per axis of α and of its change since the last filtered sample
+        [(rad/s²)²], start-corrected weight; a held sample (None) breaks the chain."""
+        prev, self.prev_alpha = self.prev_alpha, alpha
+        if alpha is None or prev is None:
+            return
+        beta = dt / NOISE_TAU
+        self.ms_alpha += beta * (alpha * alpha - self.ms_alpha)
+        self.ms_dalpha += beta * ((alpha - prev) ** 2 - self.ms_dalpha)
+        self.alpha_stats_weight += beta * (1.0 - self.alpha_stats_weight)
+
+    def _size_window(self, dt: float) -> None:
+        """Set the window of :data:`WINDOW_CHOICES` minimising the weighted r and ε (module
+        docstring); no change while the rotation is too weak to say (harbour) or unmeasured."""
+        if self.unobservable or self.alpha_stats_weight <= 0.0 or self.gyro_meter.weight <= 0.0:
+            return
+        sigma2 = self.gyro_meter.variance                             # gyro white noise per sample [(rad/s)²]
+        n_now = self.window.n
+        var_a = self.ms_alpha / self.alpha_stats_weight - sigma2 * derivative_noise_gain(n_now, dt, POLYORDER)
+        var_da = self.ms_dalpha / self.alpha_stats_weight - sigma2 * derivative_increment_gain(n_now, dt, POLYORDER)
+        if not (np.all(np.isfinite(var_da)) and var_a.sum() > 0.0 and var_da.sum() > 0.0):
+            return
+        omega_j = math.sqrt(var_da.sum() / var_a.sum()) / dt          # σ(α̇)/σ(α) [rad/s]
+        pairs = np.maximum(np.array([var_da[1] + var_da[2], var_da[0] + var_da[2], var_da[0] + var_da[1]]), 1e-300)
+        best_cost, best = math.inf, self.window_s
+        for w in WINDOW_CHOICES:
+            n = window_samples(w, dt, POLYORDER)
+            cost = (NOISE_WEIGHT * float(np.max(2.0 * sigma2 * derivative_increment_gain(n, dt, POLYORDER) / pairs))
+                    + LOSS_WEIGHT * derivative_gain_error(n, dt, POLYORDER, omega_j))
+            if cost < best_cost - 1e-12:
+                best_cost, best = cost, w
+        n_new = window_samples(best, dt, POLYORDER)
+        self.window_s = best
+        if n_new == n_now:
+            return
+        log.info("centre of rotation: differentiation window %.2f s → %.2f s (gyro noise %.2g rad/s/√Hz, "
+                 "RMS α̇ %s rad/s³, α at %.3f Hz)", (n_now - 1) * dt, (n_new - 1) * dt, math.sqrt(sigma2 * dt),
+                 np.array2string(np.sqrt(np.maximum(var_da, 0.0)) / dt, precision=2), omega_j / (2 * math.pi))
+        self.skip = max(0, (n_new - n_now) // 2)
+        self.prev_alpha = None
+        self.window.resize(n_new)
 
     def _excitation(self, alpha: np.ndarray, dt: float) -> bool:
         """Update the running mean square of |α| [rad/s²] and say whether the rotation is enough
@@ -521,11 +636,16 @@ class CentreOfRotation:
             "kf_x": self.kf.x.tolist(), "kf_P": self.kf.P.tolist(),
             "alpha_ms": self.alpha_ms, "alpha_weight": self.alpha_weight, "alpha_time": self.alpha_time,
             "unobservable": self.unobservable,
+            "gyro_meter": self.gyro_meter.get_state(), "ms_alpha": self.ms_alpha.tolist(), "ms_dalpha": self.ms_dalpha.tolist(),
+            "alpha_stats_weight": self.alpha_stats_weight,
+            "prev_alpha": None if self.prev_alpha is None else self.prev_alpha.tolist(),
+            "window_s": self.window_s, "next_sizing": self.next_sizing, "skip": self.skip,
         }
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
         self.reset()
+        self.window_s = float(s["window_s"])
         if s["dt"] is not None:
             self._start(float(s["dt"]))
             self.window.set_state(s["window"])
@@ -536,6 +656,11 @@ class CentreOfRotation:
         self.kf.x, self.kf.P = np.array(s["kf_x"]), np.array(s["kf_P"])
         self.alpha_ms, self.alpha_weight = float(s["alpha_ms"]), float(s["alpha_weight"])
         self.alpha_time, self.unobservable = float(s["alpha_time"]), bool(s["unobservable"])
+        self.gyro_meter.set_state(s["gyro_meter"])
+        self.ms_alpha, self.ms_dalpha = np.array(s["ms_alpha"]), np.array(s["ms_dalpha"])
+        self.alpha_stats_weight = float(s["alpha_stats_weight"])
+        self.prev_alpha = None if s["prev_alpha"] is None else np.array(s["prev_alpha"])
+        self.next_sizing, self.skip = float(s["next_sizing"]), int(s["skip"])
 
 
 def estimate_centre_of_rotation(acc: np.ndarray, gyro: np.ndarray, dt: float,
@@ -558,8 +683,9 @@ def estimate_centre_of_rotation(acc: np.ndarray, gyro: np.ndarray, dt: float,
     -------
     dict of numpy.ndarray
         ``offset``, ``offset_std``, ``offset_mean``, ``cr``, ``acc_cr``, ``acc_cr_n``, ``euler``,
-        ``ang_acc`` (N, 3); ``valid``, ``settled`` (N,) bool; ``delay`` (float, s). Row k refers
-        to the time t_k − delay.
+        ``ang_acc`` (N, 3); ``valid``, ``settled`` (N,) bool; ``delay`` (N,) [s]. Row k refers
+        to the time t_k − delay[k] (the delay follows the window, which ``diff_sizing = "auto"``
+        resizes).
     """
     acc = np.asarray(acc, dtype=float)
     gyro = np.asarray(gyro, dtype=float)
@@ -569,10 +695,10 @@ def estimate_centre_of_rotation(acc: np.ndarray, gyro: np.ndarray, dt: float,
     out: dict[str, Any] = {f: np.empty((n, 3)) for f in vec_fields}
     out["valid"] = np.empty(n, dtype=bool)
     out["settled"] = np.empty(n, dtype=bool)
+    out["delay"] = np.empty(n)
     for k in range(n):
         r = est.step(acc[k], gyro[k], dt, None if euler is None else euler[k])
         for f in vec_fields:
             out[f][k] = getattr(r, f)
-        out["valid"][k], out["settled"][k] = r.valid, r.settled
-    out["delay"] = est.delay
+        out["valid"][k], out["settled"][k], out["delay"][k] = r.valid, r.settled, r.delay
     return out
