@@ -151,9 +151,10 @@ def defaults_bench(progress: bool = True) -> dict:
 
     from .defaults_cr import cr_case, print_cr
     from .defaults_fusion import fusion_case, print_fusion
-    from .defaults_reconstruction import print_reconstruction, reconstruction_case
+    from .defaults_reconstruction import budget_case, print_budget, print_reconstruction, reconstruction_case
 
-    kinds = {"attitude": attitude_case, "fusion": fusion_case, "reconstruction": reconstruction_case, "cr": cr_case}
+    kinds = {"attitude": attitude_case, "fusion": fusion_case, "reconstruction": reconstruction_case,
+             "budget": budget_case, "cr": cr_case}
     with ProcessPoolExecutor(max_workers=min(2, len(CASES))) as pool:  # one case per core
         jobs = [(kind, pool.submit(run, *case)) for kind, run in kinds.items() for case in CASES]
         done: dict[str, list] = {kind: [] for kind in kinds}
@@ -187,10 +188,11 @@ def defaults_bench(progress: bool = True) -> dict:
           f"{len(rows)} cases")
     print_fusion(done["fusion"])
     print_reconstruction(done["reconstruction"])
+    print_budget(done["budget"])
     cr = print_cr(done["cr"])
     return {"attitude": {"cases": rows, "worst_deg": worst, "worst_ratio": worst_ratio,
                          "goal_deg": ATTITUDE_GOAL_DEG, "goal_ratio": RATIO_GOAL},
             "heave": {"worst_ratio": heave_ratio, "over_goal": len(heave_over), "goal_ratio": RATIO_GOAL},
             "fusion": {"cases": done["fusion"], "worst_ratio": max(r["ratio"] for r in done["fusion"])},
-            "reconstruction": {"cases": done["reconstruction"]},
+            "reconstruction": {"cases": done["reconstruction"], "budget": done["budget"]},
             "cr": {"cases": done["cr"], **cr}}

@@ -123,6 +123,38 @@ def reconstruction_case(preset: str, hs: float, tp: float, place: str, duration:
             "std_m": cog[int(t0 / DT):int(t1 / DT)].std(axis=0).tolist(), "seconds": time.perf_counter() - start}
 
 
+def budget_case(preset: str, hs: float, tp: float, place: str, duration: float = DURATION,
+                grid: tuple[dict, ...] = RECONSTRUCTION_GRID) -> dict:
+    """The error budget of :func:`~marinefmu.papers.band_budget.band_budget` on one case, for the
+    defaults' band and every other band of ``grid``, on the span :func:`reconstruction_case` scores,
+    fed the AttitudeEstimator at its defaults.
+
+    Returns
+    -------
+    dict
+        ``budget_pct``: per band (``"defaults"`` and each setting's label whose band differs), the
+        budget's ``ideal``, ``screen``, ``sensor`` and ``attitude`` [n, e, d] in % of the true COG
+        motion's std; ``seconds``.
+    """
+    from ..papers.band_budget import band_budget
+
+    start = time.perf_counter()
+    rec = case_record(preset, hs, tp, place, duration=duration)
+    acc, gyro = stack(rec, "imu.acc"), stack(rec, "imu.gyro")
+    att = estimate_attitude(gyro, acc, DT, AttitudeEstimatorParams())
+    s0 = int(round(SETTLE / DT))
+    fed = np.column_stack((att["roll"], att["pitch"], att["yaw"]))[s0:]
+    true = np.column_stack((rec["truth.roll"], rec["truth.pitch"], rec["truth.yaw"]))[s0:]
+    f_true, cog = stack(rec, "truth.imu_f")[s0:], stack(rec, "truth.cog", "ned")[s0:]
+    base = DisplacementReconstructorParams(lever_arm=tuple(float(a) for a in placements(preset)[place]))
+    w_max = max([base.window] + [g.get("window", base.window) for g in grid])
+    span = (int(round(0.5 * w_max / DT)), int(round((duration - SETTLE - 0.5 * w_max) / DT)))
+    bands = {"defaults": base, **{_label(g): replace(base, **g) for g in grid if set(g) & {"cutoff", "fmax"}}}
+    return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "seconds": time.perf_counter() - start,
+            "budget_pct": {label: band_budget(acc[s0:], f_true, fed, true, cog, DT, p.cutoff, p.fmax, span, p.lever_arm)
+                           for label, p in bands.items()}}
+
+
 def _label(g: dict) -> str:
     return ", ".join(f"{k} {v:g}" for k, v in g.items() if k not in ("pct", "sizing")) or "defaults"
 
@@ -142,6 +174,23 @@ def print_reconstruction(rows: list[dict]) -> None:
     worst = max(r["ratio"] for r in rows)
     print(f"worst ratio {worst:.2f} (goal {RATIO_GOAL}); over the goal on "
           f"{sum(r['ratio'] > RATIO_GOAL for r in rows)} of {len(rows)} cases")
+
+
+def print_budget(rows: list[dict]) -> None:
+    """Print the rows of :func:`budget_case`: per case and band, the ideal band-pass's error and
+    its attitude, sensor and screen parts (largest axis each), and the band with the least ideal
+    error."""
+    labels = list(rows[0]["budget_pct"])
+    print("DisplacementReconstructor's error budget (ideal band-pass fed the same attitude; largest axis, % of the "
+          "COG motion's std): ideal = attitude + sensor + screen parts")
+    print(f"{'vessel':<13} {'Hs':>4} {'Tp':>4} {'IMU':<4} " + " ".join(f"{lb:>24}" for lb in labels) + f" {'least ideal':>12}")
+    for r in rows:
+        b = r["budget_pct"]
+        cells = [f"{max(b[lb]['ideal']):7.1f} ({max(b[lb]['attitude']):5.1f}/{max(b[lb]['sensor']):4.1f}/"
+                 f"{max(b[lb]['screen']):4.1f})" for lb in labels]
+        least = min(labels, key=lambda lb: max(b[lb]["ideal"]))
+        print(f"{r['preset']:<13} {r['hs']:4.1f} {r['tp']:4.0f} {r['imu']:<4} " + " ".join(f"{c:>24}" for c in cells)
+              + f" {least:>12}")
 
 
 def main(cases: tuple = CASES, grid: tuple[dict, ...] = RECONSTRUCTION_GRID, save: str | None = None) -> list[dict]:
