@@ -97,7 +97,12 @@ class CentredWindow:
         self.dt, self.polyorder = dt, polyorder
         capacity = n if capacity is None else capacity
         check_int("window capacity", capacity, lo=n)
-        self.buffer = np.zeros((capacity, channels))
+        self.capacity = capacity
+        # mirrored ring: every sample is written at head and head + capacity, so the newest
+        # ``capacity`` samples are always one contiguous slice and a push costs the same for
+        # any capacity (no shift of the whole buffer)
+        self._ring = np.zeros((2 * capacity, channels))
+        self._head = capacity - 1    # the slot of the newest sample
         self.count = 0
         self.resize(n)
 
@@ -128,13 +133,20 @@ class CentredWindow:
     def push(self, sample: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """Add the newest sample; return (centre sample, smoothed, derivative [unit/s]) at the
         window centre, or None while the window is filling."""
-        self.buffer[:-1] = self.buffer[1:]
-        self.buffer[-1] = sample
+        c = self.capacity
+        h = self._head = (self._head + 1) % c
+        self._ring[h] = self._ring[h + c] = sample
         self.count += 1
         if self.count < self.n:
             return None
-        seg = self.buffer[-self.n:]
+        seg = self._ring[h + c + 1 - self.n:h + c + 1]
         return seg[self.n // 2].copy(), self._smooth @ seg, self._deriv @ seg
+
+    @property
+    def buffer(self) -> np.ndarray:
+        """(capacity, channels) the samples kept, oldest first (zeros before the first ones)."""
+        h, c = self._head, self.capacity
+        return self._ring[h + 1:h + 1 + c]
 
     def get_state(self) -> dict:
         """JSON-serialisable buffer and window length."""
@@ -142,7 +154,10 @@ class CentredWindow:
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
-        self.buffer = np.array(s["buffer"], dtype=float).reshape(self.buffer.shape)
+        c = self.capacity
+        buffer = np.array(s["buffer"], dtype=float).reshape((c, self._ring.shape[1]))
+        self._ring[:c] = self._ring[c:] = buffer
+        self._head = c - 1
         self.count = int(s["count"])
         if int(s.get("n", self.n)) != self.n:
             self.resize(int(s["n"]))
