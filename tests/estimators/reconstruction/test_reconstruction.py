@@ -156,9 +156,11 @@ def test_sliding_window_centred_estimate_and_validity():
     truth = cog[20000 - 10000:len(cog) - 10000]
     err = centred - (truth - truth.mean(axis=0))
     rel = np.sqrt(np.mean(err ** 2, axis=0)) / truth.std(axis=0)
-    # measured 0.45 / 0.74 / 3.7 % on 600 s (docs/fmus/DisplacementReconstructor.md); 130 s
-    # scored here, each window zero-mean
-    assert np.all(rel < 0.05), rel
+    # the deck-edge sensor (41, 35, -35) m from the COG, noise-free: 130 s scored here, measured
+    # 0.15 / 0.17 / 0.12 % with R_nb l high-passed at the screen; the former straight-line
+    # transfer (which subtracts R_nb l's slow part, which the screen has removed from the IMU's
+    # motion) erred 0.54 / 0.81 / 0.16 %
+    assert np.all(rel < 0.003), rel
 
 
 def test_sliding_bad_samples_hold_invalidate_and_state_round_trips():
