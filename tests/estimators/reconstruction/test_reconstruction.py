@@ -157,9 +157,9 @@ def test_sliding_window_centred_estimate_and_validity():
     err = centred - (truth - truth.mean(axis=0))
     rel = np.sqrt(np.mean(err ** 2, axis=0)) / truth.std(axis=0)
     # the deck-edge sensor (41, 35, -35) m from the COG, noise-free: 130 s scored here, measured
-    # 0.15 / 0.17 / 0.12 % with R_nb l high-passed at the screen; the former straight-line
-    # transfer (which subtracts R_nb l's slow part, which the screen has removed from the IMU's
-    # motion) erred 0.54 / 0.81 / 0.16 %
+    # 0.15 / 0.17 / 0.12 % with R_nb l high-passed at the screen; a straight-line transfer
+    # (which subtracts R_nb l's slow part, which the screen has removed from the IMU's motion)
+    # errs 0.54 / 0.81 / 0.16 %, and fails this
     assert np.all(rel < 0.003), rel
 
 

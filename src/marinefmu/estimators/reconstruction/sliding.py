@@ -19,11 +19,10 @@ The COG transfer (eq. 32) subtracts R_nb(t) l high-passed at ``cutoff`` over eac
 (:func:`~.decomposition.lever_arm_offset`, zero-phase, as the batch reconstruction does): the
 screen removes the IMU's motion below ``cutoff``, so only the lever arm's motion above it is
 subtracted. A far IMU's R_nb l has content below the screen (a gyro-integrated yaw's drift
-times l; the slow part of the rotation at the lever arm), and subtracting it (R_nb l less a
-straight line, as a former version did) leaves the IMU's slow motion in the COG's: with the IMU
-40 m from the COG and perfect inputs that errs 3-5 % of the COG's motion, and with the
-AttitudeEstimator's angles it doubled the east error (decision record "The
-DisplacementReconstructor's defaults in waves"). The lever arm's motion of the samples after the
+times l; the slow part of the rotation at the lever arm); subtracting that too (R_nb l less only
+a straight line) would leave the IMU's slow motion in the COG's: 3-5 % of the COG's motion with
+the IMU 40 m from the COG and perfect inputs (decision record "The DisplacementReconstructor's
+defaults in waves"). The lever arm's motion of the samples after the
 fitted window (the extrapolation, lags under ``hop``) continues from the window's end by the raw
 R_nb l's change.
 
