@@ -176,45 +176,53 @@ def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: 
     mean_response = np.exp(-1j * np.outer(w, np.arange(block) * dt)).mean(axis=1)
     b = -(w**2) * mean_response
     tau = np.arange(taps) * block * dt
+    wt = np.outer(w, tau)
+    cos_wt, sin_wt = np.cos(wt), np.sin(wt)        # cos(ωτ − β) = cos ωτ cos β + sin ωτ sin β: two (K, L) tables
     acc_density = np.abs(mean_response) ** 2 * (s_z * w**4 + extra + offset_noise**2 / (math.pi * w**2))
-    auto = (acc_density * d_omega) @ np.cos(np.outer(w, tau))
+    auto = (acc_density * d_omega) @ cos_wt
     auto[0] += acc_noise**2 / (block * dt)
     cross = []
     for delay in (0.0, lag):
-        phase = np.outer(w, tau - delay) - np.angle(b)[:, None]
-        cross.append((s_z * np.abs(b) * d_omega) @ np.cos(phase))
-        cross.append((s_z * w * np.abs(b) * d_omega) @ np.cos(phase + 0.5 * math.pi))
+        beta = w * delay + np.angle(b)
+        for weight, shift in ((s_z * np.abs(b) * d_omega, 0.0), (s_z * w * np.abs(b) * d_omega, 0.5 * math.pi)):
+            cross.append((weight * np.cos(beta - shift)) @ cos_wt + (weight * np.sin(beta - shift)) @ sin_wt)
     solved = solve_toeplitz(auto, np.column_stack([*cross, np.ones(taps)]))
     weights, ones = solved[:, :4], solved[:, 4]                         # R⁻¹r (L, 4), R⁻¹1
     weights -= np.outer(ones, weights.sum(axis=0) / ones.sum())         # no gain at zero frequency
     return weights.T
 
 
-class WienerHeave:
-    """Heave at the IMU and at a point by the spectrum's causal Wiener filter (module docstring).
+class WienerAxis:
+    """The causal Wiener filter of steps 1-3 (module docstring) on one scalar acceleration: the
+    displacement and velocity along that axis now and ``smoother_lag`` s ago, with the bias-step
+    search. :class:`WienerHeave` runs it on the vertical acceleration; the MotionReferenceUnit
+    runs one per axis of the level frame.
 
     Parameters
     ----------
-    params : HeaveObserverParams, optional
+    params : HeaveObserverParams
         Uses ``window``, ``window_max``, ``peak_interval``, ``omega_min``, ``omega_max``,
-        ``acc_noise``, ``offset_noise``, ``smoother_lag``, ``vertical``, ``transfer`` and
-        ``point``; ``max_modes``, ``min_separation`` and ``min_relative`` for the peaks of the
-        sea's heave spectrum reported as ``modes`` and ``omega`` (the filter has no modes;
-        :func:`~.spectrum.find_modes` on √S_z: swell and wind sea). ``model`` is ignored.
-    quiet : bool
-        Log nothing.
-
-    Examples
-    --------
-    >>> wh = WienerHeave(HeaveObserverParams(model="wiener", window=60.0))
-    >>> r = wh.step((0.0, 0.0, -9.80665), 0.0, 0.0, 0.1)
-    >>> r.valid      # no spectrum before the first window is full
-    False
+        ``acc_noise``, ``offset_noise``, ``smoother_lag``, ``max_modes``, ``min_separation``
+        and ``min_relative`` (as :class:`WienerHeave`).
+    log : logging.Logger or SilentLog
+        Where warnings go.
+    label : str
+        Names the axis in those warnings.
+    reject_below : bool
+        Whether the measured acceleration below ``omega_min`` enters the design as acceleration
+        that is not motion to estimate (``unwanted`` of :func:`wiener_taps`), as that above
+        ``omega_max`` always does. For a horizontal axis: there the attitude's slow tilt error ε
+        puts g·ε into the acceleration, which a filter designed without it passes as metres of
+        displacement below the sea's band. The vertical sees ε only at second order, and its
+        low-frequency excess is the sea's own low edge.
     """
 
-    def __init__(self, params: HeaveObserverParams | None = None, *, quiet: bool = False) -> None:
-        self.params = params or HeaveObserverParams(model="wiener")
-        self.log: Any = SilentLog() if quiet else log
+    def __init__(self, params: HeaveObserverParams, log: Any, label: str = "wiener heave",
+                 reject_below: bool = False) -> None:
+        self.params = params
+        self.log = log
+        self.label = label
+        self.reject_below = reject_below
         self.reset()
 
     def reset(self) -> None:
@@ -224,7 +232,6 @@ class WienerHeave:
         self.next_detect = 0
         self.spectrum_buf = np.zeros(0)      # ring of window_max samples of a_v
         self.sum_buf = np.zeros(0)           # running sum of a_v, twice over (contiguous reads)
-        self.angle_buf = np.zeros((0, 2))    # ring of roll, pitch for the delayed point
         self.taps: np.ndarray | None = None  # (4, L) weights of block sums, newest block first
         self.tap_sums = np.zeros(4)          # the taps' sums over the samples
         self.total = 0.0                     # the running sum at the newest sample
@@ -235,7 +242,9 @@ class WienerHeave:
         self.peaks: tuple[float, ...] = ()   # frequencies of the sea's spectral peaks [rad/s]
         self.no_sea = False                  # the last design found no sea (logged once: module docstring)
 
-    def start(self, dt: float) -> None:
+    def start(self, dt: float, first_design: float | None = None) -> None:
+        """Size the buffers for the step ``dt`` [s]; the first design after ``first_design`` s
+        of samples (``window`` if None; later to spread several axes' designs over time)."""
         p = self.params
         self.dt = dt
         self.block = max(1, int(round(BLOCK / dt)))
@@ -244,8 +253,7 @@ class WienerHeave:
         self.lag_steps = int(round(p.smoother_lag / dt))
         self.spectrum_buf = np.zeros(max(int(round(p.window / dt)), int(round(p.window_max / dt))))
         self.sum_buf = np.zeros(2 * (self.n_fir + 1))
-        self.angle_buf = np.zeros((self.lag_steps + 3, 2))
-        self.next_detect = int(round(p.window / dt))
+        self.next_detect = int(round((p.window if first_design is None else first_design) / dt))
         self.check_every = max(1, int(round(STEP_CHECK / dt)))
 
     @property
@@ -257,12 +265,6 @@ class WienerHeave:
         """The buffered accelerations (at most ``window_max`` s), oldest first."""
         n = len(self.spectrum_buf)
         return np.roll(self.spectrum_buf, -(self.k % n))[-min(self.k, n):]
-
-    def _angles(self, age: int, count: int) -> list[tuple[float, float]]:
-        """``count`` (roll, pitch) samples [rad], oldest first, ending ``age`` samples before the
-        newest stored one."""
-        n = len(self.angle_buf)
-        return [tuple(self.angle_buf[(self.k - 1 - age - j) % n]) for j in range(count - 1, -1, -1)]
 
     def _design(self) -> None:
         """Steps 1-2 on the window: new taps and mean."""
@@ -277,7 +279,7 @@ class WienerHeave:
                        0.0)
         if not np.any(sea > 0.0):
             if not self.no_sea:
-                self.log.warning("wiener heave: no sea above the accelerometer noise in [%g, %g] rad/s; %s",
+                self.log.warning("%s: no sea above the accelerometer noise in [%g, %g] rad/s; %s", self.label,
                                  p.omega_min, p.omega_max, "no filter yet, valid = false" if self.taps is None
                                  else "filter unchanged")
             self.no_sea = True
@@ -289,6 +291,8 @@ class WienerHeave:
         self.peaks = tuple(float(w) for w in found.omega)
         blocks = min(self.blocks, self.k // self.block)           # no further back than the data
         above = np.where(spectrum.omega > p.omega_max, excess, 0.0)
+        if self.reject_below:
+            above = np.where(spectrum.omega < p.omega_min, excess, above)
         self.taps = np.ascontiguousarray(wiener_taps(spectrum.omega, sea, self.dt, self.block, blocks, self.delay,
                                                      p.acc_noise, p.offset_noise, above) / self.block)  # as restored
         self.tap_sums = self.taps.sum(axis=1) * self.block
@@ -304,9 +308,9 @@ class WienerHeave:
         if found is not None:
             self._relevel(found, first)
             self.step_at = first + found.index
-            self.log.warning("wiener heave: a bias step of %+.4f m/s² at t = %.1f s (%.0f s ago, z = %.1f) found "
-                             "and taken out", found.size, self.step_at * self.dt, (self.k - self.step_at) * self.dt,
-                             found.z)
+            self.log.warning("%s: a bias step of %+.4f m/s² at t = %.1f s (%.0f s ago, z = %.1f) found "
+                             "and taken out", self.label, found.size, self.step_at * self.dt,
+                             (self.k - self.step_at) * self.dt, found.z)
         elif self.step_at is not None:
             if self.step_at <= first or (self.k - self.step_at) * self.dt > STEP_REFINE_AGE:
                 self.step_at = None
@@ -340,48 +344,34 @@ class WienerHeave:
         within = np.exp(-1j * flat * (np.arange(self.block) * self.dt)).sum(axis=1)
         return (-(w**2) * (blocks * within).reshape(w.shape))
 
-    def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
-        """Process one sample (arguments as :meth:`.OscillatorBankHeave.step`)."""
-        p = self.params
-        f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
-        if warning is None:
-            a_v = vertical_acceleration(f, roll, pitch, p.vertical) - self.level
-        else:
-            self.log.warning("wiener heave: %s; the window's mean acceleration used", warning)
-            a_v = self.mean
-            roll, pitch = self._angles(0, 1)[0] if self.k else (0.0, 0.0)      # the last good ones
+    def push(self, a: float | None) -> np.ndarray | None:
+        """One sample of the axis's acceleration ``a`` [m/s²] (None: a bad sample, which enters
+        as the window's mean): step 3's outputs, displacement [m] and velocity [m/s] now and
+        ``delay`` s ago, as a (4,) array; None before the first design. Every step: the ring
+        writes and L + 1 reads of the running sum; every :data:`STEP_CHECK` s the bias-step
+        search; every ``peak_interval`` the design."""
+        a_v = self.mean if a is None else a - self.level
         self.spectrum_buf[self.k % len(self.spectrum_buf)] = a_v
         n_sum = self.n_fir + 1
         i = self.k % n_sum
         self.total += a_v
         self.sum_buf[i] = self.sum_buf[i + n_sum] = self.total
-        self.angle_buf[self.k % len(self.angle_buf)] = (roll, pitch)
         self.k += 1
         if self.k % self.check_every == 0:
             self._check_bias_step()
         if self.k >= self.next_detect:
             self._design()
         if self.taps is None:
-            return HeaveResult(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, self.delay, 0.0, 0, 0.0, (), False, False,
-                               warning)
+            return None
         nodes = self.sum_buf[i + n_sum:i + n_sum - self.taps.shape[1] * self.block - 1:-self.block]
-        heave, rate, d_heave, d_rate = self.taps @ (nodes[:-1] - nodes[1:]) - self.mean * self.tap_sums
-        rates = backward_rate(self._angles(0, min(3, self.k)), self.dt)
-        ph, pr = point_heave(heave, rate, p.point, roll, pitch, *rates, p.transfer)
-        old = self._angles(self.lag_steps, 3)
-        d_point, _ = point_heave(d_heave, d_rate, p.point, *old[-1], *backward_rate(old, self.dt), p.transfer)
-        delayed_valid = self.k * self.dt >= p.window + self.delay
-        return HeaveResult(float(heave), float(rate), ph, pr, float(d_heave), float(d_rate), d_point, self.delay,
-                           self.level + self.mean, len(self.peaks), self.peak_period, self.peaks, warning is None,
-                           delayed_valid, warning)
+        return self.taps @ (nodes[:-1] - nodes[1:]) - self.mean * self.tap_sums
 
     def get_state(self) -> dict:
         """JSON-serialisable state."""
         def arr(v: Any) -> Any:
             return None if v is None else np.asarray(v).tolist()
         return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect, "spectrum_buf": arr(self.spectrum_buf),
-                "sum_buf": arr(self.sum_buf), "total": self.total, "angle_buf": arr(self.angle_buf),
-                "taps": arr(self.taps),
+                "sum_buf": arr(self.sum_buf), "total": self.total, "taps": arr(self.taps),
                 "mean": self.mean, "level": self.level, "step_at": self.step_at, "peak_period": self.peak_period,
                 "peaks": list(self.peaks), "no_sea": self.no_sea}
 
@@ -394,7 +384,6 @@ class WienerHeave:
         self.k, self.next_detect = int(s["k"]), int(s["next_detect"])
         self.spectrum_buf = np.array(s["spectrum_buf"], dtype=float)
         self.sum_buf, self.total = np.array(s["sum_buf"], dtype=float), float(s["total"])
-        self.angle_buf = np.array(s["angle_buf"], dtype=float).reshape(-1, 2)
         if s["taps"] is not None:
             self.taps = np.array(s["taps"], dtype=float)
             self.tap_sums = self.taps.sum(axis=1) * self.block
@@ -402,3 +391,80 @@ class WienerHeave:
         self.step_at = None if s["step_at"] is None else int(s["step_at"])
         self.peaks = tuple(float(w) for w in s["peaks"])
         self.no_sea = bool(s["no_sea"])
+
+
+class WienerHeave(WienerAxis):
+    """Heave at the IMU and at a point by the spectrum's causal Wiener filter (module docstring):
+    :class:`WienerAxis` on the vertical acceleration, and step 4.
+
+    Parameters
+    ----------
+    params : HeaveObserverParams, optional
+        Uses ``window``, ``window_max``, ``peak_interval``, ``omega_min``, ``omega_max``,
+        ``acc_noise``, ``offset_noise``, ``smoother_lag``, ``vertical``, ``transfer`` and
+        ``point``; ``max_modes``, ``min_separation`` and ``min_relative`` for the peaks of the
+        sea's heave spectrum reported as ``modes`` and ``omega`` (the filter has no modes;
+        :func:`~.spectrum.find_modes` on √S_z: swell and wind sea). ``model`` is ignored.
+    quiet : bool
+        Log nothing.
+
+    Examples
+    --------
+    >>> wh = WienerHeave(HeaveObserverParams(model="wiener", window=60.0))
+    >>> r = wh.step((0.0, 0.0, -9.80665), 0.0, 0.0, 0.1)
+    >>> r.valid      # no spectrum before the first window is full
+    False
+    """
+
+    def __init__(self, params: HeaveObserverParams | None = None, *, quiet: bool = False) -> None:
+        super().__init__(params or HeaveObserverParams(model="wiener"), SilentLog() if quiet else log)
+
+    def reset(self) -> None:
+        """Back to the initial state."""
+        super().reset()
+        self.angle_buf = np.zeros((0, 2))    # ring of roll, pitch for the delayed point
+
+    def start(self, dt: float, first_design: float | None = None) -> None:
+        super().start(dt, first_design)
+        self.angle_buf = np.zeros((self.lag_steps + 3, 2))
+
+    def _angles(self, age: int, count: int) -> list[tuple[float, float]]:
+        """``count`` (roll, pitch) samples [rad], oldest first, ending ``age`` samples before the
+        newest stored one."""
+        n = len(self.angle_buf)
+        return [tuple(self.angle_buf[(self.k - 1 - age - j) % n]) for j in range(count - 1, -1, -1)]
+
+    def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
+        """Process one sample (arguments as :meth:`.OscillatorBankHeave.step`)."""
+        p = self.params
+        f, roll, pitch, warning = read_and_start(self, acc, roll, pitch, dt)
+        a_v = None
+        if warning is None:
+            a_v = vertical_acceleration(f, roll, pitch, p.vertical)
+        else:
+            self.log.warning("%s: %s; the window's mean acceleration used", self.label, warning)
+            roll, pitch = self._angles(0, 1)[0] if self.k else (0.0, 0.0)      # the last good ones
+        self.angle_buf[self.k % len(self.angle_buf)] = (roll, pitch)
+        out = self.push(a_v)
+        if out is None:
+            return HeaveResult(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, self.delay, 0.0, 0, 0.0, (), False, False,
+                               warning)
+        heave, rate, d_heave, d_rate = out
+        rates = backward_rate(self._angles(0, min(3, self.k)), self.dt)
+        ph, pr = point_heave(heave, rate, p.point, roll, pitch, *rates, p.transfer)
+        old = self._angles(self.lag_steps, 3)
+        d_point, _ = point_heave(d_heave, d_rate, p.point, *old[-1], *backward_rate(old, self.dt), p.transfer)
+        delayed_valid = self.k * self.dt >= p.window + self.delay
+        return HeaveResult(float(heave), float(rate), ph, pr, float(d_heave), float(d_rate), d_point, self.delay,
+                           self.level + self.mean, len(self.peaks), self.peak_period, self.peaks, warning is None,
+                           delayed_valid, warning)
+
+    def get_state(self) -> dict:
+        """JSON-serialisable state."""
+        return {**super().get_state(), "angle_buf": np.asarray(self.angle_buf).tolist()}
+
+    def set_state(self, s: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        super().set_state(s)
+        if s["dt"] is not None:
+            self.angle_buf = np.array(s["angle_buf"], dtype=float).reshape(-1, 2)
