@@ -9,7 +9,8 @@ also one inside a function or under ``TYPE_CHECKING``):
   ``estimators.numerics``, ``.samples``, ``.protocol``, ``.noise_meter``) and itself; the GNSS fusion's wave coast
   (``estimators.gnss_fusion.wave_coast`` and its band observer ``.aided_band``) may also use
   paper 003's observer and its oscillator bank (``estimators.heave``), which it runs on the
-  fusion's own acceleration during a GNSS dropout;
+  fusion's own acceleration during a GNSS dropout; the motion reference unit (``estimators.mru``)
+  composes the attitude estimator and paper 003's Wiener axis filter, as one FMU;
 - the heave compensation's winch, controller and design import only estimators, sea and the shared
   modules (``ahc.loop`` runs systems);
 - no module uses another module's private name (``from x import _y`` or ``x._y``).
@@ -29,10 +30,12 @@ PACKAGE = "marinefmu"
 
 SHARED = ("marinefmu.frames", "marinefmu.errors", "marinefmu.estimators.numerics", "marinefmu.estimators.samples",
           "marinefmu.estimators.protocol", "marinefmu.estimators.noise_meter")
-ESTIMATOR_PACKAGES = ("attitude", "reconstruction", "gnss_fusion", "centre_of_rotation", "heave")
+ESTIMATOR_PACKAGES = ("attitude", "reconstruction", "gnss_fusion", "centre_of_rotation", "heave", "mru")
 # module -> packages it may import beyond the shared modules and its own package
 ALLOWED_BEYOND = {"marinefmu.estimators.gnss_fusion.wave_coast": ("marinefmu.estimators.heave",),
-                  "marinefmu.estimators.gnss_fusion.aided_band": ("marinefmu.estimators.heave",)}
+                  "marinefmu.estimators.gnss_fusion.aided_band": ("marinefmu.estimators.heave",),
+                  "marinefmu.estimators.mru.params": ("marinefmu.estimators.attitude", "marinefmu.estimators.heave"),
+                  "marinefmu.estimators.mru.unit": ("marinefmu.estimators.attitude", "marinefmu.estimators.heave")}
 USERS_OF_MODELS = tuple(f"marinefmu.{p}" for p in ("fmu", "cosim", "analysis", "bench", "campaign", "papers", "cli"))
 FMI_LIBRARIES = ("fmpy", "pythonfmu")
 

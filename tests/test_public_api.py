@@ -23,6 +23,7 @@ from marinefmu.sea.recording.player import SensorRecording, SensorRecordingParam
 from marinefmu.estimators.heave.highpass import HighpassHeave
 from marinefmu.estimators.heave.observer import build_heave_model
 from marinefmu.estimators.heave.wiener import WienerHeave
+from marinefmu import MotionReferenceUnit, MotionReferenceUnitParams
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -37,6 +38,7 @@ MODELS = {
     "AhcWinch": (AhcWinch, AhcWinchParams),
     "AhcController": (AhcController, AhcControllerParams),
     "SensorRecording": (SensorRecording, SensorRecordingParams),
+    "MotionReferenceUnit": (MotionReferenceUnit, MotionReferenceUnitParams),
 }
 # Defaults that cannot play (a recording needs its file and mapping): the example MRU export
 EXAMPLE_PARAMS = {"SensorRecording": {"file": str(ROOT / "examples/recordings/generic_mru_sample.csv"),

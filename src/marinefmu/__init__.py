@@ -38,6 +38,8 @@ _PUBLIC: dict[str, str] = {
     "CentreOfRotationParams": "marinefmu.estimators.centre_of_rotation.filter",
     "HeaveObserver": "marinefmu.estimators.heave.observer",
     "HeaveObserverParams": "marinefmu.estimators.heave.common",
+    "MotionReferenceUnit": "marinefmu.estimators.mru.unit",
+    "MotionReferenceUnitParams": "marinefmu.estimators.mru.params",
     "AhcWinch": "marinefmu.ahc.winch",
     "AhcWinchParams": "marinefmu.ahc.winch",
     "AhcController": "marinefmu.ahc.controller",
@@ -89,6 +91,8 @@ if TYPE_CHECKING:  # the same names for type checkers and IDEs
     from .estimators.gnss_fusion.filter import GnssAccFusion, GnssAccFusionParams
     from .estimators.heave.common import HeaveObserverParams
     from .estimators.heave.observer import HeaveObserver
+    from .estimators.mru.params import MotionReferenceUnitParams
+    from .estimators.mru.unit import MotionReferenceUnit
     from .estimators.protocol import Estimator
     from .estimators.reconstruction.decomposition import reconstruct_displacement
     from .estimators.reconstruction.sliding import DisplacementReconstructor, DisplacementReconstructorParams

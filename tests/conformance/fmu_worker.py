@@ -35,12 +35,13 @@ DT = 0.05                  # s, communication step of every case (20 Hz)
 RECORD_STEPS = 10600       # 530 s of VesselMotion output: 190 s warm-up + a 5-minute GNSS dropout + recovery
 OK, WARNING, DISCARD, ERROR, FATAL = range(5)
 FMUS = ("VesselMotion", "AttitudeEstimator", "DisplacementReconstructor", "GnssAccFusion", "CentreOfRotation",
-        "HeaveObserver", "AhcWinch", "AhcController")
+        "HeaveObserver", "AhcWinch", "AhcController", "MotionReferenceUnit")
 #: Inputs with no VesselMotion output of their name: (source output, offset added)
 ALIASES = {"tip.n": ("truth.point.n", 0.0), "tip.e": ("truth.point.e", 0.0), "tip.d": ("truth.point.d", 0.0),
            "tip_vel.d": ("truth.point_vel.d", 0.0), "command": ("truth.point_vel.d", 0.0),
            "heave": ("truth.point.d", 10.0), "heave_rate": ("truth.point_vel.d", 0.0), "length": ("truth.point.d", 30.0),
-           "heave_valid": ("gnss.valid", 0.0)}   # a boolean input (true through the record)
+           "heave_valid": ("gnss.valid", 0.0),   # a boolean input (true through the record)
+           "heading": ("truth.yaw", 0.3), "heading.valid": ("gnss.valid", 0.0)}
 VESSEL = {"sea.hs": 2.5, "sea.tp": 8.0, "gnss.rate": 5.0, "imu.x": 5.0, "imu.z": -3.0}
 #: Parameters of each FMU for these cases: short windows so every estimator is valid within 70 s.
 PARAMS = {
@@ -52,16 +53,19 @@ PARAMS = {
     "HeaveObserver": {"window": 60.0},
     "AhcWinch": {},
     "AhcController": {},
+    "MotionReferenceUnit": {"window": 45.0, "omega_min": 0.3, "mp1.enabled": True, "mp1.x": 20.0, "mp1.z": -5.0},
 }
 #: Steps until each FMU's outputs are valid with PARAMS (checked by the ``state`` case).
 WARM_UP = {"VesselMotion": 1, "AttitudeEstimator": 100, "DisplacementReconstructor": 1500, "GnssAccFusion": 200,
            "CentreOfRotation": 200, "HeaveObserver": 1300, "AhcWinch": 1,
-           "AhcController": 201}   # the feedforward fades in over engage_time = 10 s before valid
+           "AhcController": 201,   # the feedforward fades in over engage_time = 10 s before valid
+           "MotionReferenceUnit": 1320}  # levelling 10 s, the 45 s window, the third axis 10 s later
 #: A refused parameter per FMU (logging-off case).
 BAD_PARAMETER = {"VesselMotion": ("sea.hs", -1.0), "AttitudeEstimator": ("vel_sigma", -1.0),
                  "DisplacementReconstructor": ("window", 10.0), "GnssAccFusion": ("gate", 0.0),
                  "CentreOfRotation": ("hp_cutoff", 0.0), "HeaveObserver": ("max_modes", 0),
-                 "AhcWinch": ("stiffness", 0.0), "AhcController": ("k_p", -1.0)}
+                 "AhcWinch": ("stiffness", 0.0), "AhcController": ("k_p", -1.0),
+                 "MotionReferenceUnit": ("mp1.x", 250.0)}
 
 
 _UNZIPPED: dict[str, Path] = {}

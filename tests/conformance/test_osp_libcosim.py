@@ -32,6 +32,7 @@ WIRING = {
     "CentreOfRotation": {"acc": "imu.acc", "gyro": "imu.gyro", "roll": "truth.roll", "pitch": "truth.pitch",
                          "yaw": "truth.yaw"},
     "HeaveObserver": {"acc": "imu.acc", "roll": "truth.roll", "pitch": "truth.pitch"},
+    "MotionReferenceUnit": {"gyro": "imu.gyro", "acc": "imu.acc"},
 }
 
 

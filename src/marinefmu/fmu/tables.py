@@ -8,6 +8,7 @@ so it is defined in :mod:`marinefmu.sea.motion_model` and re-exported here as
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 from ..estimators.attitude.estimator import AID_SIZINGS, INIT_CHOICES, AttitudeEstimatorParams
@@ -18,6 +19,7 @@ from ..estimators.heave.band_bank import BAND_VARIANCES
 from ..estimators.heave.common import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
 from ..estimators.heave.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
 from ..estimators.gnss_fusion.antenna_attitude import ANTENNAS
+from ..estimators.mru.params import MAX_ARM, MAX_POINTS, MotionReferenceUnitParams
 from ..estimators.gnss_fusion.filter import ATTITUDE_CHOICES as FUSION_ATTITUDE_CHOICES
 from ..estimators.gnss_fusion.filter import NOISE_SIZINGS as FUSION_NOISE_SIZINGS
 from ..estimators.gnss_fusion.filter import COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, GnssAccFusionParams
@@ -307,6 +309,67 @@ def heave_params(values: dict[str, Any]) -> HeaveObserverParams:
         transfer=v["transfer"], point=(v["point.x"], v["point.y"], v["point.z"]), smoother_lag=v["smoother_lag"],
         highpass_cutoff=v["highpass_cutoff"], highpass_order=v["highpass_order"],
     )
+
+
+# --- MotionReferenceUnit ---
+
+_MRU = MotionReferenceUnitParams()
+_LOCATIONS = (("", "the IMU"), *((f"mp{i}.", f"monitoring point {i}") for i in range(1, MAX_POINTS + 1)))
+MRU_PARAMETERS: list[Variable] = [
+    *[v for i in range(1, MAX_POINTS + 1) for v in (
+        Variable(f"mp{i}.enabled", "boolean", False, "", f"Monitoring point {i} is computed (off unless set)"),
+        *vec(f"mp{i}", "xyz", 0.0, "m", f"Monitoring point {i} relative to the IMU, body frame; within {MAX_ARM:g} m "
+             "of the IMU"))],
+    real("window", _MRU.motion.window, "s", "First spectrum window of each axis (the motion is valid after it), "
+         "[4 pi / omega_min, 3600]"),
+    real("window_max", _MRU.motion.window_max, "s", "Longest spectrum window, [window, 3600]"),
+    real("omega_min", _MRU.motion.omega_min, "rad/s", "Lowest wave frequency estimated, (0, omega_max)"),
+    real("omega_max", _MRU.motion.omega_max, "rad/s", "Highest wave frequency estimated, (omega_min, 20]"),
+    real("acc_noise", _MRU.motion.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 1]"),
+    real("delayed_lag", _MRU.motion.smoother_lag, "s", "Delay of the delayed outputs, [0, 120]"),
+    real("heading_tau", _MRU.heading_tau, "s", "Time constant of the heading aid, [1, 3600]"),
+]
+MRU_INPUTS: list[Variable] = [
+    *vec("gyro", "xyz", 0.0, "rad/s", "Angular rate, body frame"),
+    *vec("acc", "xyz", (0.0, 0.0, -9.80665), "m/s2", "Specific force, body frame"),
+    real("heading", 0.0, "rad", "True heading of the body x axis, clockwise from north (used while heading.valid)"),
+    Variable("heading.valid", "boolean", False, "", "heading holds a measurement"),
+]
+MRU_OUTPUTS: list[Variable] = [
+    real("roll", 0.0, "rad", "Roll (ZYX Euler)"),
+    real("pitch", 0.0, "rad", "Pitch (ZYX Euler)"),
+    real("yaw", 0.0, "rad", "Yaw (ZYX Euler): north-referenced once a valid heading arrived, else gyro-integrated"),
+    *[v for prefix, where in _LOCATIONS for v in (
+        real(f"{prefix}surge", 0.0, "m", f"Surge of {where} about its mean position, level frame (x along the mean heading)"),
+        real(f"{prefix}sway", 0.0, "m", f"Sway of {where} about its mean position, level frame (y to starboard)"),
+        real(f"{prefix}heave", 0.0, "m", f"Heave of {where} about its mean position, positive down"),
+        real(f"{prefix}surge_rate", 0.0, "m/s", f"Surge velocity of {where}, level frame"),
+        real(f"{prefix}sway_rate", 0.0, "m/s", f"Sway velocity of {where}, level frame"),
+        real(f"{prefix}heave_rate", 0.0, "m/s", f"Heave velocity of {where}, positive down"),
+        real(f"{prefix}heave_acc", 0.0, "m/s2", f"Vertical acceleration of {where}, positive down, bias removed"),
+        real(f"{prefix}delayed.surge", 0.0, "m", f"Smoothed surge of {where} at time - delayed.delay"),
+        real(f"{prefix}delayed.sway", 0.0, "m", f"Smoothed sway of {where} at time - delayed.delay"),
+        real(f"{prefix}delayed.heave", 0.0, "m", f"Smoothed heave of {where} at time - delayed.delay, positive down"))],
+    real("delayed.delay", 0.0, "s", "Delay of the delayed outputs"),
+    real("wave_period", 0.0, "s", "Dominant wave period: the peak of the heave spectrum (0 before the first)"),
+]
+MRU_BOOLEANS: list[Variable] = [
+    Variable("valid", "boolean", False, "", "roll, pitch, yaw: false while levelling and on a rejected (NaN/Inf/absurd) sample"),
+    Variable("motion.valid", "boolean", False, "", "The real-time motion: false until every axis's first spectrum and on a rejected sample"),
+    Variable("delayed.valid", "boolean", False, "", "The delayed outputs refer to a time the filters have run through"),
+    Variable("heading.used", "boolean", False, "", "yaw is north-referenced"),
+]
+
+
+def mru_params(values: dict[str, Any]) -> MotionReferenceUnitParams:
+    """MotionReferenceUnitParams from FMI-named values: the points enabled, in order, and the
+    axes' filter parameters on the HeaveObserver's defaults."""
+    v = resolve(MRU_PARAMETERS, values, "MotionReferenceUnit")
+    points = tuple((v[f"mp{i}.x"], v[f"mp{i}.y"], v[f"mp{i}.z"]) for i in range(1, MAX_POINTS + 1)
+                   if v[f"mp{i}.enabled"])
+    motion = replace(_MRU.motion, window=v["window"], window_max=v["window_max"], omega_min=v["omega_min"],
+                     omega_max=v["omega_max"], acc_noise=v["acc_noise"], smoother_lag=v["delayed_lag"])
+    return MotionReferenceUnitParams(motion=motion, points=points, heading_tau=v["heading_tau"])
 
 
 # --- AHC FMUs: AhcWinch and AhcController ---

@@ -1,0 +1,130 @@
+"""Benchmark part ``mru``: the MotionReferenceUnit at its defaults, given its monitoring points
+only, against VesselMotion's truth, beside the datasheets of commercial units.
+
+The grid is the ``defaults`` part's (:data:`~.defaults.CASES`: the three vessel presets × the
+three benchmark seas × the IMU at the COG and far from it), default MEMS IMU, one seed, 600 s,
+scored from :data:`~.defaults.SETTLE` s or the first valid sample, whichever is later. The
+monitoring points (:data:`POINTS`, relative to the IMU, body frame) reach 59.8 m from the IMU.
+
+Each figure is an RMS error with the truth's and the error's means removed (motion about the
+mean position; the filters have no output at zero frequency), against the truth's standard
+deviation on the same axis (not the amplitude: a vendor's "5 % of amplitude" is 5 % of about
+√2 σ for a sinusoid, 2σ for Hs = 4σ of a sea, so their percentages are looser than ours by
+that factor). The goals (:func:`goals`): roll and pitch as the AttitudeEstimator at its
+defaults (it is that estimator); real-time heave ≤ max(2 cm, 2.5 % of std), surge and sway ≤
+max(2 cm, 5 % of std) at every point; the delayed outputs ≤ half the real-time error.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..estimators.mru.params import MotionReferenceUnitParams
+from ..estimators.mru.unit import AXES, MotionReferenceUnit
+from ..frames import rot_nb
+from ..sea.motion_model import stack
+from .defaults import CASES, DT, SETTLE, case_record
+
+#: Monitoring points relative to the IMU, body frame [m]: a point near the IMU, one aft and to
+#: port, one high on the beam, and one 59.8 m forward and above (a crane or gangway tip on the
+#: longest lever arm the goals cover).
+POINTS: tuple[tuple[float, float, float], ...] = ((20.0, 5.0, -5.0), (-30.0, -8.0, -10.0), (0.0, 10.0, -20.0),
+                                                  (59.0, 0.0, -10.0))
+
+
+def point_truth(rec: dict[str, np.ndarray], arm: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """True position and velocity [m], [m/s] (N, 3) of the point at ``arm`` from the IMU (body
+    frame) in VesselMotion's NED, whose north is the mean heading: surge, sway, heave of the
+    vessel's level frame."""
+    r = np.asarray(arm, dtype=float)
+    angles = np.column_stack([rec["truth.roll"], rec["truth.pitch"], rec["truth.yaw"]])
+    rots = np.array([rot_nb(*a) for a in angles])
+    rate = stack(rec, "truth.rate")
+    pos = stack(rec, "truth.imu", "ned") + rots @ r
+    vel = stack(rec, "truth.imu_vel", "ned") + np.einsum("nij,nj->ni", rots, np.cross(rate, r))
+    return pos, vel
+
+
+def run_mru(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams) -> dict[str, np.ndarray]:
+    """The MotionReferenceUnit over a VesselMotion record: (N, ·) arrays of every output."""
+    mru = MotionReferenceUnit(params, quiet=True)
+    gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
+    n, rows = len(acc), len(params.points) + 1
+    out = {"roll": np.empty(n), "pitch": np.empty(n), "position": np.empty((n, rows, 3)),
+           "velocity": np.empty((n, rows, 3)), "delayed": np.empty((n, rows, 3)), "valid": np.empty(n, bool),
+           "delayed_valid": np.empty(n, bool)}
+    for k in range(n):
+        r = mru.step(gyro[k], acc[k], DT)
+        out["roll"][k], out["pitch"][k] = r.roll, r.pitch
+        out["position"][k], out["velocity"][k], out["delayed"][k] = r.position, r.velocity, r.delayed_position
+        out["valid"][k], out["delayed_valid"][k] = r.motion_valid, r.delayed_valid
+    out["delay"] = np.array(mru.delay)
+    return out
+
+
+def rms_about_mean(err: np.ndarray) -> np.ndarray:
+    """RMS of ``err`` (N, …) over axis 0 with its mean removed."""
+    return np.sqrt(np.mean((err - err.mean(axis=0)) ** 2, axis=0))
+
+
+def goals(std_cm: np.ndarray) -> np.ndarray:
+    """(…, 3) goals [cm] of surge, sway, heave for truth standard deviations ``std_cm``."""
+    return np.maximum(2.0, std_cm * np.array([0.05, 0.05, 0.025]))
+
+
+def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None = None) -> dict:
+    """One case: the real-time and delayed errors [cm] at the IMU and each point of
+    :data:`POINTS` per axis, the truth's std, the goals, and roll and pitch [deg]."""
+    rec = case_record(preset, hs, tp, place, extra=extra)
+    out = run_mru(rec, MotionReferenceUnitParams(points=POINTS))
+    k0 = max(int(SETTLE / DT), int(np.argmax(out["valid"])) if out["valid"].any() else len(DT * out["valid"]))
+    lag = int(round(float(out["delay"]) / DT))
+    rows = []
+    for j, arm in enumerate(((0.0, 0.0, 0.0), *POINTS)):
+        pos, vel = point_truth(rec, arm)
+        est = out["position"][k0:, j]
+        err = rms_about_mean(est - pos[k0:])
+        vel_err = rms_about_mean(out["velocity"][k0:, j] - vel[k0:])
+        delayed = rms_about_mean(out["delayed"][k0 + lag:, j] - pos[k0:len(pos) - lag])
+        std = np.std(pos[k0:], axis=0)
+        rows.append({"arm_m": arm, "distance_m": float(np.linalg.norm(arm)), "std_cm": 100 * std,
+                     "rt_cm": 100 * err, "delayed_cm": 100 * delayed, "vel_cms": 100 * vel_err,
+                     "vel_std_cms": 100 * np.std(vel[k0:], axis=0), "goal_cm": goals(100 * std)})
+    roll = np.degrees(np.sqrt(np.mean(np.angle(np.exp(1j * (out["roll"][k0:] - rec["truth.roll"][k0:]))) ** 2)))
+    pitch = np.degrees(np.sqrt(np.mean((out["pitch"][k0:] - rec["truth.pitch"][k0:]) ** 2)))
+    return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "roll_deg": float(roll), "pitch_deg": float(pitch),
+            "delay_s": float(out["delay"]), "points": rows}
+
+
+def print_mru(rows: list[dict]) -> dict:
+    """The part's tables; returns the summary (cases over each goal)."""
+    print("MotionReferenceUnit at its defaults, given the monitoring points only: RMS error [cm] "
+          "(real-time / delayed) per axis against the goal; worst point of each case")
+    print(f"{'vessel':<13} {'Hs':>4} {'Tp':>4} {'IMU':<4} {'roll/pitch deg':>15} "
+          + " ".join(f"{a + ' rt/dl/goal':>20}" for a in AXES))
+    over, delayed_over = 0, 0
+    for r in rows:
+        worst = [max(r["points"], key=lambda p, i=i: p["rt_cm"][i] / p["goal_cm"][i]) for i in range(3)]
+        cells = " ".join(f"{w['rt_cm'][i]:6.2f}/{w['delayed_cm'][i]:5.2f}/{w['goal_cm'][i]:5.2f}"
+                         for i, w in enumerate(worst)).split(" ")
+        print(f"{r['preset']:<13} {r['hs']:4.1f} {r['tp']:4.0f} {r['imu']:<4} {r['roll_deg']:7.4f}/{r['pitch_deg']:.4f} "
+              + " ".join(f"{c:>20}" for c in cells))
+        over += any(np.any(p["rt_cm"] > p["goal_cm"]) for p in r["points"])
+        delayed_over += any(np.any(p["delayed_cm"] > 0.5 * p["rt_cm"]) for p in r["points"])
+    print(f"real-time over its goal on {over} of {len(rows)} cases; delayed above half the real-time error on "
+          f"{delayed_over} of {len(rows)}")
+    return {"over_goal": over, "delayed_over": delayed_over, "cases": len(rows)}
+
+
+def mru_bench(progress: bool = True) -> dict:
+    """Every case of :data:`~.defaults.CASES`, two at a time (about 10 minutes on a 2-core
+    machine), printed as a table."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from tqdm import tqdm
+
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        jobs = [pool.submit(mru_case, *case) for case in CASES]
+        rows = [job.result() for job in tqdm(jobs, unit="case", desc="mru", disable=not progress)]
+    return {"cases": rows, **print_mru(rows)}

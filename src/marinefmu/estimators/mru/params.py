@@ -1,0 +1,132 @@
+"""Parameters and result of :class:`~marinefmu.estimators.mru.unit.MotionReferenceUnit`."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import ParameterError, check_range, check_vector
+from ..attitude.estimator import AttitudeEstimatorParams
+from ..heave.common import HeaveObserverParams
+
+#: Most monitoring points.
+MAX_POINTS = 4
+#: Farthest monitoring point from the IMU [m]: beyond it a lever arm is taken for a unit error
+#: (millimetres for metres) rather than a point on the vessel.
+MAX_ARM = 200.0
+#: Default delay of the delayed outputs [s]: by then the Wiener smoother has seen the
+#: following half period of the longest benchmark sea twice over, and errs less than half as
+#: much as the real-time estimate (``marinefmu bench --parts mru``).
+DELAYED_LAG = 20.0
+#: Time constant of the heading aid [s]: how fast the yaw output follows a heading input.
+HEADING_TAU = 30.0
+#: Time constant of each of the two cascaded first-order low-passes that give the level
+#: frame's reference yaw [s] (:mod:`.level_frame`).
+YAW_TAU = 30.0
+#: Time constant of the two cascaded first-order low-passes that give a lever arm's mean [s].
+ARM_TAU = 100.0
+
+
+def default_motion() -> HeaveObserverParams:
+    """The three axes' filter parameters: the HeaveObserver's defaults with the delayed lag
+    :data:`DELAYED_LAG`."""
+    return HeaveObserverParams(smoother_lag=DELAYED_LAG)
+
+
+@dataclass(frozen=True)
+class MotionReferenceUnitParams:
+    """Parameters of :class:`~marinefmu.estimators.mru.unit.MotionReferenceUnit` (FMU names in
+    brackets).
+
+    Parameters
+    ----------
+    attitude : AttitudeEstimatorParams
+        The attitude estimator's (its defaults: drift-corrected, sized from the data).
+    motion : HeaveObserverParams
+        The filter of each level-frame axis (``model`` must be ``"wiener"``; uses the fields
+        :class:`~marinefmu.estimators.heave.wiener.WienerAxis` names); ``smoother_lag`` is the
+        delay of the delayed outputs, [0, 120] s, :data:`DELAYED_LAG` by default.
+        [``window``, ``window_max``, ``omega_min``, ``omega_max``, ``acc_noise``,
+        ``delayed_lag``]
+    points : tuple of (3,) tuples
+        Up to :data:`MAX_POINTS` monitoring points, each a lever arm from the IMU to the point,
+        body frame [m], each within :data:`MAX_ARM` of the IMU and finite.
+        [``mp{1..4}.{x,y,z}``, ``mp{1..4}.enabled``]
+    heading_tau : float
+        Time constant of the heading aid [s], [1, 3600] (:data:`HEADING_TAU`). [``heading_tau``]
+    """
+
+    attitude: AttitudeEstimatorParams = field(default_factory=AttitudeEstimatorParams)
+    motion: HeaveObserverParams = field(default_factory=default_motion)
+    points: tuple[tuple[float, float, float], ...] = ()
+    heading_tau: float = HEADING_TAU
+
+    def __post_init__(self) -> None:
+        if self.motion.model != "wiener":
+            raise ParameterError(f"motion.model must be 'wiener' (the MotionReferenceUnit's axis filter), "
+                                 f"got {self.motion.model!r}")
+        if len(self.points) > MAX_POINTS:
+            raise ParameterError(f"points: at most {MAX_POINTS} monitoring points, got {len(self.points)}")
+        checked = []
+        for i, arm in enumerate(self.points):
+            name = f"mp{i + 1}"
+            arm = check_vector(name, arm, unit="m")
+            distance = math.sqrt(sum(a * a for a in arm))
+            if distance > MAX_ARM:
+                raise ParameterError(f"{name} must lie within {MAX_ARM:g} m of the IMU, got {distance:.1f} m "
+                                     f"({', '.join(f'{a:g}' for a in arm)})")
+            checked.append(arm)
+        object.__setattr__(self, "points", tuple(checked))
+        check_range("heading_tau", self.heading_tau, lo=1.0, hi=3600.0, unit="s")
+
+
+@dataclass(frozen=True)
+class MruResult:
+    """Output of one :meth:`~marinefmu.estimators.mru.unit.MotionReferenceUnit.step`.
+
+    Rows of the (P + 1, ·) arrays: the IMU, then the monitoring points in order. Columns of the
+    (·, 3) arrays: surge, sway, heave, i.e. x forward, y starboard, z down of the vessel's level
+    frame (heave positive down), about the point's mean position.
+
+    Attributes
+    ----------
+    roll, pitch, yaw : float
+        ZYX Euler angles [rad]; yaw is north-referenced while a heading input aids it
+        (``heading_used``), else the gyro-integrated yaw.
+    position, velocity : numpy.ndarray
+        (P + 1, 3) real-time surge, sway, heave [m] and their rates [m/s].
+    heave_acc : numpy.ndarray
+        (P + 1,) vertical acceleration [m/s², down], the bias estimate removed.
+    delayed_position : numpy.ndarray
+        (P + 1, 3) surge, sway, heave ``delay`` s before this sample [m].
+    delay : float
+        Lag of the delayed outputs [s].
+    wave_period : float
+        Period of the peak of the heave spectrum [s] (0 before the first spectrum).
+    valid : bool
+        Roll, pitch and yaw: levelled and the sample good.
+    motion_valid : bool
+        The real-time motion: every axis's filter designed and the sample good.
+    delayed_valid : bool
+        The delayed outputs refer to a time the filters have run through.
+    heading_used : bool
+        The yaw output is north-referenced (a valid heading has been received).
+    warning : str or None
+        Why the sample was not used, if it was not.
+    """
+
+    roll: float
+    pitch: float
+    yaw: float
+    position: np.ndarray
+    velocity: np.ndarray
+    heave_acc: np.ndarray
+    delayed_position: np.ndarray
+    delay: float
+    wave_period: float
+    valid: bool
+    motion_valid: bool
+    delayed_valid: bool
+    heading_used: bool
+    warning: str | None = None

@@ -1,0 +1,219 @@
+"""The MotionReferenceUnit: what a commercial motion reference unit outputs, from one IMU.
+
+Per sample (:meth:`MotionReferenceUnit.step`):
+
+1. **Attitude**: the AttitudeEstimator at its parameters (paper 000 eqs. 6-9 with the aided
+   tilt correction; :mod:`marinefmu.estimators.attitude.estimator`) gives R_nb, roll, pitch and
+   the gyro-integrated yaw ψ.
+2. **Level frame** (:mod:`.level_frame`): R_hb = Rz(−ψ̄) R_nb, with ψ̄ the slow part of ψ, and
+   the IMU's acceleration there, a_h = R_hb f_b + [0, 0, g] (the horizontal specific force after
+   tilt compensation).
+3. **Three axes**: surge, sway and heave of the IMU, each by paper 003's observer generalised
+   from the vertical: the causal Wiener filter designed from that axis's own measured spectrum
+   (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`, the HeaveObserver's default
+   filter; its docstring has steps 1-3), now and ``motion.smoother_lag`` s ago (the delayed
+   outputs: the Wiener smoother for that lag). The horizontal axes take the vertical's design
+   parameters; their spectra and filters are their own.
+4. **Monitoring points**: each adds its lever arm's motion about its mean, R_hb r − ⟨R_hb r⟩,
+   and its rate and acceleration (:mod:`.level_frame`), the exact rigid-body transfer (paper
+   003 eqs. 10-11 generalised to three axes and a 3-D lever arm).
+5. **Heading** (optional): a valid heading input ψ_in turns the yaw output to north by a
+   first-order correction, ψ_out = ψ + c, c ← c + (1 − e^{−Δt/τ}) wrap(ψ_in − ψ − c)
+   (``heading_tau``; the first valid heading sets c). It does not enter the motion, which is
+   in the level frame of the mean heading either way.
+
+What runs when: every step, the attitude, one 3 × 3 rotation, three FIR outputs of L + 1
+running-sum reads each, and the points' arms; every second, each axis's bias-step search; every
+``motion.peak_interval`` s, one axis's Wiener design, the three axes a third of an interval
+apart, so that no step designs more than one.
+
+Bad samples (NaN, Inf, absurd; the AttitudeEstimator's checks): the attitude coasts on the last
+good sample, each axis takes the window's mean acceleration (its estimate decays rather than
+drifts), the points keep the last good attitude, ``valid`` and ``motion_valid`` are false and
+the step's ``warning`` says why (also logged). While the attitude levels (the first
+``attitude.level_time`` s) the axes take no acceleration either: the tilt is not yet known.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+import numpy as np
+
+from ...frames import G, quat_to_rot
+from ..attitude.estimator import AttitudeEstimator
+from ..heave.common import SilentLog
+from ..heave.wiener import WienerAxis
+from ..samples import MAX_YAW
+from .level_frame import SlowLowPass, derivative_weights, unwrap, yaw_rotation
+from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
+
+log = logging.getLogger(__name__)
+
+#: The level frame's axes, in the order of the outputs' columns.
+AXES = ("surge", "sway", "heave")
+
+
+class MotionReferenceUnit:
+    """Attitude and three-axis motion at the IMU and at monitoring points (module docstring).
+
+    Parameters
+    ----------
+    params : MotionReferenceUnitParams, optional
+        Validated parameters (the defaults if omitted).
+    quiet : bool
+        Log nothing from the motion filters.
+
+    Examples
+    --------
+    >>> mru = MotionReferenceUnit(MotionReferenceUnitParams(points=((25.0, 0.0, -8.0),)))
+    >>> r = mru.step((0.0, 0.0, 0.0), (0.0, 0.0, -9.80665), 0.01)
+    >>> r.position.shape, r.motion_valid          # IMU and one point; not yet designed
+    ((2, 3), False)
+    """
+
+    def __init__(self, params: MotionReferenceUnitParams | None = None, *, quiet: bool = False) -> None:
+        self.params = params or MotionReferenceUnitParams()
+        self.log: Any = SilentLog() if quiet else log
+        self.arms = np.array(self.params.points, dtype=float).reshape(-1, 3)      # (P, 3) body [m]
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the initial state."""
+        p = self.params
+        self.attitude = AttitudeEstimator(p.attitude)
+        self.axes = [WienerAxis(p.motion, self.log, f"mru {name}", reject_below=name != "heave") for name in AXES]
+        self.yaw_ref = SlowLowPass(YAW_TAU)
+        self.arm_mean = SlowLowPass(ARM_TAU, from_zero=True)
+        self.dt: float | None = None
+        self.k = 0
+        self.yaw: float | None = None                 # the unwrapped gyro yaw [rad]
+        self.heading_offset: float | None = None      # c of the heading aid [rad]
+        self.rot = np.eye(3)                          # R_hb of the last good sample
+        self.heave_acc = 0.0                          # the last good vertical acceleration [m/s²]
+        self.arm_ring = np.zeros((0, len(self.arms), 3))
+
+    def start(self, dt: float) -> None:
+        """Size the buffers for the step ``dt`` [s]."""
+        m = self.params.motion
+        self.dt = dt
+        for i, axis in enumerate(self.axes):          # heave first, then surge and sway a third apart
+            axis.start(dt, m.window + m.peak_interval * ((i + 1) % 3) / 3.0)
+        self.weights = derivative_weights(dt)
+        self.lag_steps = self.axes[0].lag_steps
+        self.arm_ring = np.zeros((max(self.lag_steps + 1, self.weights.shape[1]), len(self.arms), 3))
+        self.delayed_from = m.window + m.peak_interval * 2.0 / 3.0 + self.axes[0].delay
+
+    @property
+    def delay(self) -> float:
+        """Lag of the delayed outputs [s]."""
+        return self.axes[0].delay
+
+    def step(self, gyro: Any, acc: Any, dt: float, heading: float | None = None,
+             heading_valid: bool = True) -> MruResult:
+        """Process one IMU sample.
+
+        Parameters
+        ----------
+        gyro : array_like
+            (3,) angular rate [rad/s, body].
+        acc : array_like
+            (3,) specific force [m/s², body].
+        dt : float
+            Step [s] (> 0); a change restarts every filter, with a warning.
+        heading : float, optional
+            True heading of the body x axis [rad, clockwise from north]; None for none.
+        heading_valid : bool
+            Whether ``heading`` holds a measurement.
+        """
+        restart = None
+        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
+            restart = f"step size changed from {self.dt} s to {dt} s; every filter restarted"
+            self.log.warning("mru: %s", restart)
+            self.reset()
+        if self.dt is None:
+            self.start(dt)
+        att = self.attitude.step(gyro, acc, dt)
+        good = att.valid and att.warning is None
+        a_h = None
+        if good:
+            self.yaw = att.yaw if self.yaw is None else unwrap(self.yaw, att.yaw)
+            ref = float(self.yaw_ref.push(np.array([self.yaw]), dt)[0])
+            self.rot = yaw_rotation(ref) @ quat_to_rot(np.asarray(att.q))
+            a_h = self.rot @ np.asarray(acc, dtype=float)
+            a_h[2] += G
+        outs = [axis.push(None if a_h is None else float(a_h[i])) for i, axis in enumerate(self.axes)]
+        n = len(self.arm_ring)
+        if good or self.k == 0:
+            arm = self.arms @ self.rot.T - self.arms                         # (P, 3): R_hb r − r
+            self.arm_ring[self.k % n] = arm - self.arm_mean.push(arm, dt) if good else 0.0
+        else:
+            self.arm_ring[self.k % n] = self.arm_ring[(self.k - 1) % n]
+        self.k += 1
+        heave_axis = self.axes[2]
+        if a_h is not None:
+            self.heave_acc = float(a_h[2]) - heave_axis.level - heave_axis.mean
+        yaw_out, heading_used, heading_warning = self._heading(att.yaw, heading, heading_valid, dt)
+        warning = restart or att.warning or heading_warning
+        rows = len(self.arms) + 1
+        if any(o is None for o in outs):
+            zeros = np.zeros((rows, 3))
+            return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros.copy(), np.zeros(rows), zeros.copy(),
+                             self.delay, heave_axis.peak_period, att.valid, False, False, heading_used, warning)
+        o = np.array(outs)                                                   # (3 axes, 4)
+        w = self.weights.shape[1]
+        recent = self.arm_ring[(self.k - w + np.arange(w)) % n]              # (W, P, 3), oldest first
+        d_rate = np.tensordot(self.weights, recent, axes=(1, 0)) if self.k >= w else np.zeros((2, len(self.arms), 3))
+        arm_now = self.arm_ring[(self.k - 1) % n]
+        arm_then = self.arm_ring[(self.k - 1 - self.lag_steps) % n]
+        position = np.vstack([o[:, 0], o[:, 0] + arm_now])
+        velocity = np.vstack([o[:, 1], o[:, 1] + d_rate[0]])
+        heave_acc = np.concatenate([[self.heave_acc], self.heave_acc + d_rate[1][:, 2]])
+        delayed = np.vstack([o[:, 2], o[:, 2] + arm_then])
+        return MruResult(att.roll, att.pitch, yaw_out, position, velocity, heave_acc, delayed, self.delay,
+                         heave_axis.peak_period, att.valid, good, good and self.k * dt >= self.delayed_from,
+                         heading_used, warning)
+
+    def _heading(self, yaw: float, heading: float | None, heading_valid: bool,
+                 dt: float) -> tuple[float, bool, str | None]:
+        """Step 5: the yaw output [rad], whether it is north-referenced, and why a heading
+        sample was not used, if it was not."""
+        warning = None
+        if heading is not None and heading_valid:
+            if math.isfinite(heading) and abs(heading) <= MAX_YAW:
+                error = math.remainder(heading - yaw - (self.heading_offset or 0.0), 2.0 * math.pi)
+                if self.heading_offset is None:
+                    self.heading_offset = error
+                else:
+                    self.heading_offset += (1.0 - math.exp(-dt / self.params.heading_tau)) * error
+            else:
+                warning = f"heading sample {heading!r} not finite or beyond ±{MAX_YAW:g} rad; not used"
+                self.log.warning("mru: %s", warning)
+        if self.heading_offset is None:
+            return yaw, False, warning
+        return math.remainder(yaw + self.heading_offset, 2.0 * math.pi), True, warning
+
+    def get_state(self) -> dict:
+        """JSON-serialisable state."""
+        return {"dt": self.dt, "k": self.k, "attitude": self.attitude.get_state(),
+                "axes": [axis.get_state() for axis in self.axes], "yaw_ref": self.yaw_ref.get_state(),
+                "arm_mean": self.arm_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
+                "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "arm_ring": self.arm_ring.ravel().tolist(),
+                "arm_ring_shape": list(self.arm_ring.shape)}
+
+    def set_state(self, s: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.reset()
+        if s["dt"] is not None:
+            self.start(float(s["dt"]))
+        self.k = int(s["k"])
+        self.attitude.set_state(s["attitude"])
+        for axis, st in zip(self.axes, s["axes"]):
+            axis.set_state(st)
+        self.yaw_ref.set_state(s["yaw_ref"])
+        self.arm_mean.set_state(s["arm_mean"])
+        self.yaw, self.heading_offset = s["yaw"], s["heading_offset"]
+        self.rot = np.array(s["rot"], dtype=float)
+        self.heave_acc = float(s["heave_acc"])
+        self.arm_ring = np.array(s["arm_ring"], dtype=float).reshape(s["arm_ring_shape"])
