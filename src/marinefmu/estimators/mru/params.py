@@ -105,7 +105,8 @@ class MruResult:
     wave_period : float
         Period of the peak of the heave spectrum [s] (0 before the first spectrum).
     valid : bool
-        Roll, pitch and yaw: levelled and the sample good.
+        Roll, pitch and yaw: levelled, the IMU sample good and the heading sample, if one is
+        given, good.
     motion_valid : bool
         The real-time motion: every axis's filter designed and the sample good.
     delayed_valid : bool
