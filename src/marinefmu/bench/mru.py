@@ -88,9 +88,10 @@ def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None =
         vel_err = rms_about_mean(out["velocity"][k0:, j] - vel[k0:])
         delayed = rms_about_mean(out["delayed"][k0 + lag:, j] - pos[k0:len(pos) - lag])
         std = np.std(pos[k0:], axis=0)
-        rows.append({"arm_m": arm, "distance_m": float(np.linalg.norm(arm)), "std_cm": 100 * std,
-                     "rt_cm": 100 * err, "delayed_cm": 100 * delayed, "vel_cms": 100 * vel_err,
-                     "vel_std_cms": 100 * np.std(vel[k0:], axis=0), "goal_cm": goals(100 * std)})
+        rows.append({"arm_m": arm, "distance_m": float(np.linalg.norm(arm)), "std_cm": (100 * std).tolist(),
+                     "rt_cm": (100 * err).tolist(), "delayed_cm": (100 * delayed).tolist(),
+                     "vel_cms": (100 * vel_err).tolist(), "vel_std_cms": (100 * np.std(vel[k0:], axis=0)).tolist(),
+                     "goal_cm": goals(100 * std).tolist()})
     roll = np.degrees(np.sqrt(np.mean(np.angle(np.exp(1j * (out["roll"][k0:] - rec["truth.roll"][k0:]))) ** 2)))
     pitch = np.degrees(np.sqrt(np.mean((out["pitch"][k0:] - rec["truth.pitch"][k0:]) ** 2)))
     return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "roll_deg": float(roll), "pitch_deg": float(pitch),
@@ -104,22 +105,53 @@ def print_mru(rows: list[dict]) -> dict:
     print(f"{'vessel':<13} {'Hs':>4} {'Tp':>4} {'IMU':<4} {'roll/pitch deg':>15} "
           + " ".join(f"{a + ' rt/dl/goal':>20}" for a in AXES))
     over, delayed_over = 0, 0
+    rows = [{**r, "points": [{k: np.asarray(v) for k, v in p.items()} for p in r["points"]]} for r in rows]
     for r in rows:
         worst = [max(r["points"], key=lambda p, i=i: p["rt_cm"][i] / p["goal_cm"][i]) for i in range(3)]
-        cells = " ".join(f"{w['rt_cm'][i]:6.2f}/{w['delayed_cm'][i]:5.2f}/{w['goal_cm'][i]:5.2f}"
-                         for i, w in enumerate(worst)).split(" ")
+        cells = [f"{w['rt_cm'][i]:.2f}/{w['delayed_cm'][i]:.2f}/{w['goal_cm'][i]:.2f}" for i, w in enumerate(worst)]
         print(f"{r['preset']:<13} {r['hs']:4.1f} {r['tp']:4.0f} {r['imu']:<4} {r['roll_deg']:7.4f}/{r['pitch_deg']:.4f} "
               + " ".join(f"{c:>20}" for c in cells))
         over += any(np.any(p["rt_cm"] > p["goal_cm"]) for p in r["points"])
         delayed_over += any(np.any(p["delayed_cm"] > 0.5 * p["rt_cm"]) for p in r["points"])
     print(f"real-time over its goal on {over} of {len(rows)} cases; delayed above half the real-time error on "
           f"{delayed_over} of {len(rows)}")
-    return {"over_goal": over, "delayed_over": delayed_over, "cases": len(rows)}
+    return {"over_goal": over, "delayed_over": delayed_over, "n_cases": len(rows)}
+
+
+def cost_per_step(steps: int = 30000) -> dict[str, float]:
+    """In-process µs per step of the MotionReferenceUnit with four points, the AttitudeEstimator
+    and the HeaveObserver at their defaults, on the first case's record (best of two runs; the
+    design and bias-step work amortised over the run, which spans two designs per axis)."""
+    import time
+
+    from ..estimators.attitude.estimator import AttitudeEstimator
+    from ..estimators.heave.observer import HeaveObserver
+
+    rec = case_record(*CASES[0][:4], duration=steps * DT)
+    gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
+    roll, pitch = rec["truth.roll"], rec["truth.pitch"]
+
+    def timed(make, run) -> float:
+        best = math.inf
+        for _ in range(2):
+            model = make()
+            t = time.perf_counter()
+            for k in range(steps):
+                run(model, k)
+            best = min(best, time.perf_counter() - t)
+        return 1e6 * best / steps
+
+    mru = timed(lambda: MotionReferenceUnit(MotionReferenceUnitParams(points=POINTS), quiet=True),
+                lambda m, k: m.step(gyro[k], acc[k], DT))
+    att = timed(AttitudeEstimator, lambda m, k: m.step(gyro[k], acc[k], DT))
+    heave = timed(lambda: HeaveObserver(quiet=True), lambda m, k: m.step(acc[k], roll[k], pitch[k], DT))
+    return {"mru_us": mru, "attitude_us": att, "heave_us": heave, "budget_us": att + 1.5 * heave}
 
 
 def mru_bench(progress: bool = True) -> dict:
     """Every case of :data:`~.defaults.CASES`, two at a time (about 10 minutes on a 2-core
-    machine), printed as a table."""
+    machine), printed as a table, and the cost per step against its budget (the
+    AttitudeEstimator's plus 1.5 × the HeaveObserver's)."""
     from concurrent.futures import ProcessPoolExecutor
 
     from tqdm import tqdm
@@ -127,4 +159,9 @@ def mru_bench(progress: bool = True) -> dict:
     with ProcessPoolExecutor(max_workers=2) as pool:
         jobs = [pool.submit(mru_case, *case) for case in CASES]
         rows = [job.result() for job in tqdm(jobs, unit="case", desc="mru", disable=not progress)]
-    return {"cases": rows, **print_mru(rows)}
+    summary = print_mru(rows)
+    cost = cost_per_step()
+    print(f"cost per step in-process: MotionReferenceUnit (4 points) {cost['mru_us']:.0f} us; budget "
+          f"{cost['budget_us']:.0f} us = AttitudeEstimator {cost['attitude_us']:.0f} + 1.5 x HeaveObserver "
+          f"{cost['heave_us']:.0f}")
+    return {"cases": rows, **summary, "cost": cost}

@@ -163,7 +163,7 @@ def _over_goal(summary: dict, goal: float) -> str:
 
 #: Parts of ``marinefmu bench``, in the order they run.
 PARTS = ("speed", "heave", "peer", "orcaflex", "dropout", "dropout_gyro", "pos_std", "system", "ahc", "campaign", "hydro",
-         "defaults", "recording", "memory")
+         "defaults", "mru", "recording", "memory")
 #: Seas of the peer comparison, calm / moderate / rough (Hs [m], Tp [s]) on the ``system`` vessel.
 PEER_SEAS = {"calm": (1.0, 6.0), "moderate": (3.0, 9.0), "rough": (6.0, 11.0)}
 #: Seas of the heave accuracy part (paper 003 checks, Hs [m], Tp [s]; Hs 4 / Tp 12 and
@@ -403,6 +403,10 @@ def run_benchmarks(out_dir: Path, steps: int = 60000, fmu_dir: Path | None = Non
             from .defaults import defaults_bench
 
             data["defaults"] = {**stamp, **defaults_bench()}
+        elif part == "mru":  # the MotionReferenceUnit against truth and its cost (marinefmu.bench.mru)
+            from .mru import mru_bench
+
+            data["mru"] = {**stamp, **mru_bench()}
         elif part == "recording":  # a 24-hour 100 Hz record streamed (marinefmu.bench.recording)
             from .recording import recording_bench
 

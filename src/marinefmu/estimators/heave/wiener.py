@@ -215,14 +215,20 @@ class WienerAxis:
         puts g·ε into the acceleration, which a filter designed without it passes as metres of
         displacement below the sea's band. The vertical sees ε only at second order, and its
         low-frequency excess is the sea's own low edge.
+    find_steps : bool
+        Whether to search the window for bias steps (module docstring). Off where the design
+        rejects the band below ``omega_min`` (``reject_below``): a step's 1/ω² density then
+        meets no gain, and on a horizontal axis the tilt error's slow wander is found as steps
+        that are not there.
     """
 
     def __init__(self, params: HeaveObserverParams, log: Any, label: str = "wiener heave",
-                 reject_below: bool = False) -> None:
+                 reject_below: bool = False, find_steps: bool = True) -> None:
         self.params = params
         self.log = log
         self.label = label
         self.reject_below = reject_below
+        self.find_steps = find_steps
         self.reset()
 
     def reset(self) -> None:
@@ -242,11 +248,13 @@ class WienerAxis:
         self.peaks: tuple[float, ...] = ()   # frequencies of the sea's spectral peaks [rad/s]
         self.no_sea = False                  # the last design found no sea (logged once: module docstring)
 
-    def start(self, dt: float, first_design: float | None = None) -> None:
+    def start(self, dt: float, first_design: float | None = None, interval: float | None = None) -> None:
         """Size the buffers for the step ``dt`` [s]; the first design after ``first_design`` s
-        of samples (``window`` if None; later to spread several axes' designs over time)."""
+        of samples (``window`` if None; later to spread several axes' designs over time), the
+        next every ``interval`` s (``peak_interval`` if None)."""
         p = self.params
         self.dt = dt
+        self.interval_steps = max(1, int(round((p.peak_interval if interval is None else interval) / dt)))
         self.block = max(1, int(round(BLOCK / dt)))
         self.blocks = max(2, int(round(MEMORY / (self.block * dt))))
         self.n_fir = self.block * self.blocks
@@ -269,7 +277,7 @@ class WienerAxis:
     def _design(self) -> None:
         """Steps 1-2 on the window: new taps and mean."""
         p = self.params
-        self.next_detect = self.k + max(1, int(round(p.peak_interval / self.dt)))
+        self.next_detect = self.k + self.interval_steps
         win = self._window()
         self.sum_buf -= self.total          # keep the running sum near zero: its differences are unchanged
         self.total = 0.0
@@ -357,7 +365,7 @@ class WienerAxis:
         self.total += a_v
         self.sum_buf[i] = self.sum_buf[i + n_sum] = self.total
         self.k += 1
-        if self.k % self.check_every == 0:
+        if self.find_steps and self.k % self.check_every == 0:
             self._check_bias_step()
         if self.k >= self.next_detect:
             self._design()
@@ -424,8 +432,8 @@ class WienerHeave(WienerAxis):
         super().reset()
         self.angle_buf = np.zeros((0, 2))    # ring of roll, pitch for the delayed point
 
-    def start(self, dt: float, first_design: float | None = None) -> None:
-        super().start(dt, first_design)
+    def start(self, dt: float, first_design: float | None = None, interval: float | None = None) -> None:
+        super().start(dt, first_design, interval)
         self.angle_buf = np.zeros((self.lag_steps + 3, 2))
 
     def _angles(self, age: int, count: int) -> list[tuple[float, float]]:

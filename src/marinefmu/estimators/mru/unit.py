@@ -13,7 +13,9 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`, the HeaveObserver's default
    filter; its docstring has steps 1-3), now and ``motion.smoother_lag`` s ago (the delayed
    outputs: the Wiener smoother for that lag). The horizontal axes take the vertical's design
-   parameters; their spectra and filters are their own.
+   parameters; their spectra and filters are their own, and their designs reject the
+   acceleration below ``omega_min`` (the attitude's slow tilt error times g), so they have no
+   bias-step search (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`).
 4. **Monitoring points**: each adds its lever arm's motion about its mean, R r − ⟨R r⟩ with
    R = Rz(ψ_w) Ry(θ) Rx(φ), and its rate and acceleration (:mod:`.level_frame`), the exact
    rigid-body transfer (paper 003 eqs. 10-11 generalised to three axes and a 3-D lever arm).
@@ -32,8 +34,9 @@ Per sample (:meth:`MotionReferenceUnit.step`):
 
 What runs when: every step, the attitude, one 3 × 3 rotation, four FIR outputs of L + 1
 running-sum reads each, and the points' arms; every second, each filter's bias-step search;
-every ``motion.peak_interval`` s, each filter's Wiener design, the four a quarter of an
-interval apart, so that no step designs more than one.
+first after ``motion.window`` s and then every :data:`DESIGN_ROUNDS` × ``motion.peak_interval``
+s, each filter's Wiener design, the four a quarter of an interval apart (on average one
+design per interval in all, as the HeaveObserver), so that no step designs more than one.
 
 Bad samples (NaN, Inf, absurd; the AttitudeEstimator's checks): the attitude coasts on the last
 good sample, each axis takes the window's mean acceleration (its estimate decays rather than
@@ -61,6 +64,10 @@ from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
 
+#: Each filter is designed again every DESIGN_ROUNDS × ``motion.peak_interval`` s (a quarter
+#: interval after the previous filter), so that the four cost one HeaveObserver's designs: the window they read grows to 20 minutes, and over one minute the
+#: design barely moves.
+DESIGN_ROUNDS = 4
 #: The level frame's axes, in the order of the outputs' columns.
 AXES = ("surge", "sway", "heave")
 
@@ -108,8 +115,9 @@ class MotionReferenceUnit:
         """Back to the initial state."""
         p = self.params
         self.attitude = AttitudeEstimator(p.attitude)
-        self.axes = [WienerAxis(p.motion, self.log, f"mru {name}", reject_below=name != "heave") for name in AXES]
-        self.yaw_axis = WienerAxis(yaw_filter_params(p), self.log, "mru yaw", reject_below=True)
+        self.axes = [WienerAxis(p.motion, self.log, f"mru {name}", reject_below=name != "heave",
+                                find_steps=name == "heave") for name in AXES]
+        self.yaw_axis = WienerAxis(yaw_filter_params(p), self.log, "mru yaw", reject_below=True, find_steps=False)
         self.yaw_ref = SlowLowPass(YAW_TAU)
         self.arm_mean = SlowLowPass(ARM_TAU, from_zero=True)
         self.dt: float | None = None
@@ -124,8 +132,10 @@ class MotionReferenceUnit:
         """Size the buffers for the step ``dt`` [s]."""
         m = self.params.motion
         self.dt = dt
-        for i, axis in enumerate((*self.axes, self.yaw_axis)):   # heave, yaw, surge, sway a quarter apart
-            axis.start(dt, m.window + m.peak_interval * (2, 3, 0, 1)[i] / 4.0)
+        filters = (*self.axes, self.yaw_axis)
+        for i, axis in enumerate(filters):            # heave, yaw, surge, sway a quarter interval apart
+            axis.start(dt, m.window + m.peak_interval * (2, 3, 0, 1)[i] / 4.0,
+                       interval=DESIGN_ROUNDS * m.peak_interval)
         self.weights = derivative_weights(dt)
         self.lag_steps = self.axes[0].lag_steps
         self.arm_ring = np.zeros((max(self.lag_steps + 1, self.weights.shape[1]), len(self.arms), 3))
