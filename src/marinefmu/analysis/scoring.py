@@ -261,10 +261,14 @@ def ahc_scores(result: np.ndarray, system: SystemDescription, settle: float = 60
                 feeds[w] = "truth"
             elif feeder.kind == "HeaveObserver":
                 feeds[w] = "classical" if feeder.parameters.get("model") == "highpass" else "observer"
+            elif feeder.kind == "MotionReferenceUnit":
+                feeds[w] = "mru"
         out[w] = row
     for w, feed in feeds.items():
-        if feed == "observer" and "residual_pct" in out[w]:
-            for other, key in (("truth", "vs_ideal"), ("classical", "vs_classical")):
+        if feed in ("observer", "mru") and "residual_pct" in out[w]:
+            for other, key in (("truth", "vs_ideal"), ("classical", "vs_classical"), ("observer", "vs_observer")):
+                if other == feed:
+                    continue
                 ref = [out[o]["residual_pct"] for o, f in feeds.items() if f == other and "residual_pct" in out[o]]
                 if ref:
                     out[w][key] = out[w]["residual_pct"] / ref[0]

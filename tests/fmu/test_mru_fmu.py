@@ -1,0 +1,51 @@
+"""The MotionReferenceUnit FMU run by FMPy equals the in-process unit bit for bit, with its
+monitoring points mapped to their own outputs (a point left off stays zero)."""
+import math
+
+import numpy as np
+import pytest
+from tests.conftest import DT, Driver
+
+from marinefmu.bench.defaults import case_record
+from marinefmu.estimators.mru.unit import MotionReferenceUnit
+from marinefmu.fmu.tables import mru_params
+from marinefmu.sea.motion_model import stack
+
+PARAMS = {"window": 45.0, "omega_min": 0.3, "delayed_lag": 5.0, "mp2.x": 20.0, "mp2.z": -5.0}
+LOCATION = ("surge", "sway", "heave", "surge_rate", "sway_rate", "heave_rate", "heave_acc", "delayed.surge",
+            "delayed.sway", "delayed.heave")
+OUTS = ["roll", "pitch", "yaw", *LOCATION, *(f"mp2.{n}" for n in LOCATION), "mp1.heave", "delayed.delay",
+        "wave_period"]
+FLAGS = ("valid", "motion.valid", "delayed.valid", "heading.used")
+
+
+@pytest.mark.fmu
+def test_mru_fmu_equals_in_process(fmu_dir, tmp_path):
+    rec = case_record("polar_supply", 3.0, 10.0, "cog", duration=80.0)
+    gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
+    f = Driver(fmu_dir / "MotionReferenceUnit.fmu", tmp_path, "mru")
+    f.fmu.setBoolean([f.vr["mp2.enabled"].valueReference], [True])
+    f.init(PARAMS)
+    model = MotionReferenceUnit(mru_params({**PARAMS, "mp2.enabled": True}))
+    assert model.params.points == ((20.0, 0.0, -5.0),)
+    nan_at = 7000
+    for k in range(len(acc)):
+        a = acc[k].copy()
+        if k == nan_at:
+            a[2] = math.nan
+        inputs = {**{f"gyro.{x}": float(v) for x, v in zip("xyz", gyro[k])},
+                  **{f"acc.{x}": float(v) for x, v in zip("xyz", a)}}
+        status, reals, flags = f.step(k, inputs, OUTS, FLAGS)
+        r = model.step(gyro[k], a, DT)
+        assert status in (0, None)
+        expected = [r.roll, r.pitch, r.yaw,
+                    *r.position[0], *r.velocity[0], r.heave_acc[0], *r.delayed_position[0],
+                    *r.position[1], *r.velocity[1], r.heave_acc[1], *r.delayed_position[1],
+                    0.0, r.delay, r.wave_period]
+        assert reals == expected, k
+        assert flags == [r.valid, r.motion_valid, r.delayed_valid, r.heading_used], k
+        if k == nan_at:
+            assert not flags[0] and not flags[1] and all(np.isfinite(reals))
+    assert flags[:3] == [True, True, True]
+    assert abs(reals[OUTS.index("mp2.heave")] - reals[OUTS.index("heave")]) > 1e-3   # the point is not the IMU
+    f.close()
