@@ -328,6 +328,10 @@ MRU_PARAMETERS: list[Variable] = [
     real("acc_noise", _MRU.motion.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 1]"),
     real("delayed_lag", _MRU.motion.smoother_lag, "s", "Delay of the delayed outputs, [0, 120]"),
     real("heading_tau", _MRU.heading_tau, "s", "Time constant of the heading aid, [1, 3600]"),
+    Variable("aid_sizing", "string", _MRU.attitude.aid_sizing, "", f"Attitude aiding size: one of {', '.join(AID_SIZINGS)} (as the AttitudeEstimator's)"),
+    real("vel_sigma", _MRU.attitude.vel_sigma, "m/s", "Attitude zero-velocity pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 100]"),
+    real("pos_sigma", _MRU.attitude.pos_sigma, "m", "Attitude zero-position pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 1000]"),
+    real("aid_rate", _MRU.attitude.aid_rate, "Hz", "Attitude pseudo-measurement rate, (0, 100]"),
 ]
 MRU_INPUTS: list[Variable] = [
     *vec("gyro", "xyz", 0.0, "rad/s", "Angular rate, body frame"),
@@ -369,7 +373,9 @@ def mru_params(values: dict[str, Any]) -> MotionReferenceUnitParams:
                    if v[f"mp{i}.enabled"])
     motion = replace(_MRU.motion, window=v["window"], window_max=v["window_max"], omega_min=v["omega_min"],
                      omega_max=v["omega_max"], acc_noise=v["acc_noise"], smoother_lag=v["delayed_lag"])
-    return MotionReferenceUnitParams(motion=motion, points=points, heading_tau=v["heading_tau"])
+    attitude = replace(_MRU.attitude, aid_sizing=v["aid_sizing"], vel_sigma=v["vel_sigma"], pos_sigma=v["pos_sigma"],
+                       aid_rate=v["aid_rate"])
+    return MotionReferenceUnitParams(attitude=attitude, motion=motion, points=points, heading_tau=v["heading_tau"])
 
 
 # --- AHC FMUs: AhcWinch and AhcController ---
