@@ -54,6 +54,7 @@ class SlowLowPass:
         self.tau = tau
         self.from_zero = from_zero
         self.stages: np.ndarray | None = None       # (2, …) the two stages' outputs
+        self.dt, self.alpha = math.nan, 0.0         # the step the coefficient was computed for
 
     def push(self, x: np.ndarray, dt: float) -> np.ndarray:
         """The low-passed ``x`` after one step ``dt`` [s]."""
@@ -61,7 +62,9 @@ class SlowLowPass:
             self.stages = np.stack([x, x]).astype(float) * (0.0 if self.from_zero else 1.0)
             if not self.from_zero:
                 return self.stages[1].copy()
-        alpha = 1.0 - math.exp(-dt / self.tau)
+        if dt != self.dt:
+            self.dt, self.alpha = dt, 1.0 - math.exp(-dt / self.tau)
+        alpha = self.alpha
         self.stages[0] += alpha * (x - self.stages[0])
         self.stages[1] += alpha * (self.stages[0] - self.stages[1])
         return self.stages[1].copy()

@@ -180,7 +180,9 @@ class MotionReferenceUnit:
             a_h = self.rot @ np.asarray(acc, dtype=float)
             a_h[2] += G
         outs = [axis.push(None if a_h is None else float(a_h[i])) for i, axis in enumerate(self.axes)]
-        yaw_wave = self.yaw_axis.push(euler_yaw_rate(gyro, att) if good else None)
+        yaw_wave = None                                # the yaw filter serves the lever arms only
+        if len(self.arms):
+            yaw_wave = self.yaw_axis.push(euler_yaw_rate(gyro, att) if good else None)
         n = len(self.arm_ring)
         if good or self.k == 0:
             rot = self.rot if yaw_wave is None else rot_nb(att.roll, att.pitch, float(yaw_wave[1]))
@@ -196,7 +198,7 @@ class MotionReferenceUnit:
         warning = restart or att.warning or heading_warning
         angles_valid = att.valid and heading_warning is None
         rows = len(self.arms) + 1
-        if any(o is None for o in outs) or yaw_wave is None:
+        if any(o is None for o in outs) or (yaw_wave is None and len(self.arms)):
             zeros = np.zeros((rows, 3))
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros.copy(), np.zeros(rows), zeros.copy(),
                              self.delay, heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
