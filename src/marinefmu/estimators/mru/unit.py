@@ -27,14 +27,6 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    over the low-pass's 30 s, about 0.13° on the default MEMS grade: on ``polar_supply`` in
    Hs 3 m / Tp 10 s the sway 59 m forward of the IMU errs 11 cm with it, 4.2 cm with the
    filter (the IMU's own sway errs 3.5 cm).
-   The delayed heave of a point is made otherwise: the heave filter is linear, so the smoothed
-   heave of the point's vertical acceleration is the IMU's plus the smoother applied to the
-   arm's vertical acceleration, whose running sum is its velocity [R_hb (ω × r)]_d / Δt,
-   straight from the gyro; the attitude's error then enters only through R_hb, at second
-   order. On ``polar_supply`` in Hs 3 m / Tp 10 s it takes the delayed heave 59 m forward of
-   the IMU from 3.1 to 1.9 cm. (In real time the causal filter's response to the arm, whose
-   spectrum is not the IMU's, errs more than the attitude does; horizontally the yaw arm
-   through the sway smoother errs more than the angles.)
 5. **Heading** (optional): a valid heading input ψ_in turns the yaw output to north by a
    first-order correction, ψ_out = ψ + c, c ← c + (1 − e^{−Δt/τ}) wrap(ψ_in − ψ − c)
    (``heading_tau``; the first valid heading sets c). It does not enter the motion, which is
@@ -135,8 +127,6 @@ class MotionReferenceUnit:
         self.rot = np.eye(3)                          # R_hb of the last good sample
         self.heave_acc = 0.0                          # the last good vertical acceleration [m/s²]
         self.arm_ring = np.zeros((0, len(self.arms), 3))
-        self.arm_sums = np.zeros((0, len(self.arms)))      # the arms' vertical velocity / Δt, twice over
-        self.arm_rate = np.zeros(len(self.arms))           # the last good one [m/s]
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -149,7 +139,6 @@ class MotionReferenceUnit:
         self.weights = derivative_weights(dt)
         self.lag_steps = self.axes[0].lag_steps
         self.arm_ring = np.zeros((max(self.lag_steps + 1, self.weights.shape[1]), len(self.arms), 3))
-        self.arm_sums = np.zeros((2 * (self.axes[2].n_fir + 1), len(self.arms)))
         self.delayed_from = m.window + m.peak_interval * 3.0 / 4.0 + self.axes[0].delay
 
     @property
@@ -201,12 +190,6 @@ class MotionReferenceUnit:
             self.arm_ring[self.k % n] = arm - self.arm_mean.push(arm, dt) if good else 0.0
         else:
             self.arm_ring[self.k % n] = self.arm_ring[(self.k - 1) % n]
-        if len(self.arms):
-            if good:
-                w = np.asarray(gyro, dtype=float) - np.asarray(att.gyro_bias)
-                self.arm_rate = np.cross(w, self.arms) @ self.rot[2]         # [R_hb (ω × r)]_d
-            n_sum = len(self.arm_sums) // 2
-            self.arm_sums[self.k % n_sum] = self.arm_sums[self.k % n_sum + n_sum] = self.arm_rate / dt
         self.k += 1
         heave_axis = self.axes[2]
         if a_h is not None:
@@ -229,19 +212,9 @@ class MotionReferenceUnit:
         velocity = np.vstack([o[:, 1], o[:, 1] + d_rate[0]])
         heave_acc = np.concatenate([[self.heave_acc], self.heave_acc + d_rate[1][:, 2]])
         delayed = np.vstack([o[:, 2], o[:, 2] + arm_then])
-        delayed[1:, 2] = o[2, 2] + self._delayed_arm_heave()
         return MruResult(att.roll, att.pitch, yaw_out, position, velocity, heave_acc, delayed, self.delay,
                          heave_axis.peak_period, angles_valid, good, good and self.k * dt >= self.delayed_from,
                          heading_used, warning)
-
-    def _delayed_arm_heave(self) -> np.ndarray:
-        """Step 4's delayed heave of the lever arms [m] (P,): the heave smoother on their
-        vertical acceleration, as running sums of their velocity [R_hb (ω × r)]_d / Δt."""
-        axis = self.axes[2]
-        n_sum = len(self.arm_sums) // 2
-        i = (self.k - 1) % n_sum + n_sum
-        nodes = self.arm_sums[i:i - axis.taps.shape[1] * axis.block - 1:-axis.block]     # (L + 1, P)
-        return axis.taps[2] @ (nodes[:-1] - nodes[1:])
 
     def _heading(self, yaw: float, heading: float | None, heading_valid: bool,
                  dt: float) -> tuple[float, bool, str | None]:
@@ -269,8 +242,7 @@ class MotionReferenceUnit:
                 "yaw_ref": self.yaw_ref.get_state(),
                 "arm_mean": self.arm_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
                 "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "arm_ring": self.arm_ring.ravel().tolist(),
-                "arm_ring_shape": list(self.arm_ring.shape), "arm_sums": self.arm_sums.ravel().tolist(),
-                "arm_sums_shape": list(self.arm_sums.shape), "arm_rate": self.arm_rate.tolist()}
+                "arm_ring_shape": list(self.arm_ring.shape)}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -288,5 +260,3 @@ class MotionReferenceUnit:
         self.rot = np.array(s["rot"], dtype=float)
         self.heave_acc = float(s["heave_acc"])
         self.arm_ring = np.array(s["arm_ring"], dtype=float).reshape(s["arm_ring_shape"])
-        self.arm_sums = np.array(s["arm_sums"], dtype=float).reshape(s["arm_sums_shape"])
-        self.arm_rate = np.array(s["arm_rate"], dtype=float)
