@@ -103,7 +103,9 @@ def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None =
     :data:`POINTS` per axis, the truth's std, the goals, and roll and pitch [deg]."""
     rec = case_record(preset, hs, tp, place, extra=extra)
     out = run_mru(rec, MotionReferenceUnitParams(points=POINTS))
-    k0 = max(int(SETTLE / DT), int(np.argmax(out["valid"])) if out["valid"].any() else len(DT * out["valid"]))
+    if not out["valid"].any():        # no sea above the noise the filters assume: no motion output
+        return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "valid": False}
+    k0 = max(int(SETTLE / DT), int(np.argmax(out["valid"])))
     lag = int(round(float(out["delay"]) / DT))
     rows = []
     for j, arm in enumerate(((0.0, 0.0, 0.0), *POINTS)):
@@ -119,7 +121,8 @@ def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None =
                      "goal_cm": goals(100 * std).tolist()})
     roll = np.degrees(np.sqrt(np.mean(np.angle(np.exp(1j * (out["roll"][k0:] - rec["truth.roll"][k0:]))) ** 2)))
     pitch = np.degrees(np.sqrt(np.mean((out["pitch"][k0:] - rec["truth.pitch"][k0:]) ** 2)))
-    return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "roll_deg": float(roll), "pitch_deg": float(pitch),
+    return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "valid": True, "roll_deg": float(roll),
+            "pitch_deg": float(pitch),
             "delay_s": float(out["delay"]), "points": rows,
             "true_attitude_imu_cm": true_attitude_cm(rec, MotionReferenceUnitParams(points=POINTS), k0)}
 
@@ -183,6 +186,9 @@ def print_heave_and_angles(rows: list[dict]) -> None:
     """Roll and pitch [deg] and the real-time heave at the farthest point against its goal."""
     print(f"{'vessel':<13} {'Hs':>4} {'Tp':>4} {'roll/pitch deg':>15} {'heave rt cm at 59.8 m':>22} {'goal':>6}")
     for r in rows:
+        if not r.get("valid", True):
+            print(f"{r['preset']:<13} {r['hs']:4.1f} {r['tp']:4.0f}  no valid motion: no sea above the filters' noise")
+            continue
         far = max(r["points"], key=lambda p: p["distance_m"])
         print(f"{r['preset']:<13} {r['hs']:4.1f} {r['tp']:4.0f} {r['roll_deg']:7.4f}/{r['pitch_deg']:.4f} "
               f"{far['rt_cm'][2]:22.2f} {far['goal_cm'][2]:6.2f}")
@@ -210,3 +216,32 @@ def mru_bench(progress: bool = True) -> dict:
           f"{cost['budget_us']:.0f} us = AttitudeEstimator {cost['attitude_us']:.0f} + 1.5 x HeaveObserver "
           f"{cost['heave_us']:.0f}")
     return {"cases": rows, **summary, "mru_grade": mru_rows, "cost": cost}
+
+
+def markdown(data: dict) -> str:
+    """The docs page's tables from this part's output (``bench.json``'s ``mru``): per case, the
+    worst point's real-time / delayed error against the goal per axis, and the IMU's with the
+    true attitude; then the ``mru`` grade's angles and farthest-point heave."""
+    lines = ["| vessel | Hs m | Tp s | IMU | roll / pitch ° | surge cm | sway cm | heave cm | IMU, true attitude cm |",
+             "|---|---:|---:|---|---:|---:|---:|---:|---:|"]
+    for r in data["cases"]:
+        pts = [{k: np.asarray(v) for k, v in p.items()} for p in r["points"]]
+        cells = []
+        for i in range(3):
+            w = max(pts, key=lambda p: p["rt_cm"][i] / p["goal_cm"][i])
+            mark = "" if w["rt_cm"][i] <= w["goal_cm"][i] else " ✗"
+            cells.append(f"{w['rt_cm'][i]:.1f} / {w['delayed_cm'][i]:.1f} ({w['goal_cm'][i]:.1f}){mark}")
+        true = " / ".join(f"{x:.1f}" for x in r["true_attitude_imu_cm"])
+        lines.append(f"| {r['preset']} | {r['hs']:g} | {r['tp']:g} | {r['imu']} | {r['roll_deg']:.3f} / "
+                     f"{r['pitch_deg']:.3f} | {' | '.join(cells)} | {true} |")
+    lines += ["", "| vessel, `imu.grade = mru` | Hs m | Tp s | roll / pitch ° | heave at 59.8 m cm (goal) |",
+              "|---|---:|---:|---:|---:|"]
+    for r in data.get("mru_grade", []):
+        if not r.get("valid", True) or "points" not in r:
+            lines.append(f"| {r['preset']} | {r['hs']:g} | {r['tp']:g} | — | no valid motion (no sea above the "
+                         "filters' noise) |")
+            continue
+        far = max(r["points"], key=lambda p: p["distance_m"])
+        lines.append(f"| {r['preset']} | {r['hs']:g} | {r['tp']:g} | {r['roll_deg']:.4f} / {r['pitch_deg']:.4f} | "
+                     f"{far['rt_cm'][2]:.2f} ({far['goal_cm'][2]:.2f}) |")
+    return "\n".join(lines)
