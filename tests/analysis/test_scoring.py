@@ -73,3 +73,56 @@ def test_estimates_are_compared_with_the_truth_one_communication_step_earlier():
                                (), 0.1, 200.0)
     assert score(r, system, "vessel")["att"]["roll_deg"] == 0.0
     assert score(r, system, "vessel", delay=0)["att"]["roll_deg"] > 0.01
+
+
+def _mru_system(mp1=(5.0, 2.0, -1.0)):
+    vessel = Component("vessel", "VesselMotion.fmu", {"imu.x": 1.0, "imu.y": 0.0, "imu.z": -2.0,
+                                                       "point.x": 6.0, "point.y": 2.0, "point.z": -3.0})
+    mru = Component("mru", "MotionReferenceUnit.fmu", {"mp1.enabled": True, "mp1.x": mp1[0], "mp1.y": mp1[1],
+                                                        "mp1.z": mp1[2]})
+    return SystemDescription("s", (vessel, mru), (), 0.1, 200.0)
+
+
+def test_a_motion_reference_unit_is_scored_at_its_imu_and_at_the_vessels_point_with_its_delay():
+    """Known errors: 1, 2, 3 cm square waves at the IMU; at the point (mp1 = the vessel's point
+    minus its IMU) 2 cm on each axis, so 2√3 cm in 3-D; the delayed outputs are the truth
+    ``delay`` s late, so score 0; roll and pitch from ``valid``, the motion from ``motion.valid``."""
+    from marinefmu.analysis.scoring import mru_point
+
+    n, dt, lag = 2001, 0.1, 50
+    t = np.arange(n) * dt
+    wave, square = np.sin(0.7 * t), np.sign(np.sin(3.0 * t + 0.1))
+    locs = [("imu", ""), ("point", "mp1.")]
+    fields = ["vessel.truth.roll", "vessel.truth.pitch", "mru.roll", "mru.pitch", "mru.valid", "mru.motion.valid",
+              "mru.delayed.delay"] + [f"vessel.truth.{w}.{a}" for w, _ in locs for a in "ned"] + [
+              f"mru.{p}{d}{x}" for _, p in locs for d in ("", "delayed.") for x in ("surge", "sway", "heave")]
+    r = np.zeros(n, dtype=[("time", "f8")] + [(f, "?" if f.endswith("valid") else "f8") for f in fields])
+    r["time"] = t
+    r["mru.valid"], r["mru.motion.valid"] = t >= 10.0, t >= 50.0   # scored from 70 s and 110 s
+    r["vessel.truth.roll"] = 0.05 * wave
+    r["mru.roll"] = r["vessel.truth.roll"] + math.radians(0.01) * square
+    r["mru.delayed.delay"] = lag * dt
+    for (w, p), errors in zip(locs, ((0.01, 0.02, 0.03), (0.02, 0.02, 0.02))):
+        for i, ((x, a), e) in enumerate(zip((("surge", "n"), ("sway", "e"), ("heave", "d")), errors)):
+            truth = 4.0 + (1.0 + i) * wave                                              # a mean the unit has not
+            r[f"vessel.truth.{w}.{a}"] = truth
+            r[f"mru.{p}{x}"] = truth - 4.0 + e * square
+            r[f"mru.{p}delayed.{x}"] = np.r_[np.zeros(lag), truth[:-lag]]
+    system = _mru_system()
+    assert mru_point(system, "mru", "vessel") == "mp1."
+    s = score(r, system, "vessel", delay=0)["mru"]
+    assert s["roll_deg"] == pytest.approx(0.01, rel=1e-3) and s["pitch_deg"] == 0.0
+    assert s["scored_s"] == pytest.approx(200.0 - 70.0 + 0.1, abs=1e-9)
+    span = t >= 110.0
+    sq = square[span] - square[span].mean()                     # the error about its mean over the span
+    for p, errors in (("", (1.0, 2.0, 3.0)), ("point_", (2.0, 2.0, 2.0))):
+        for x, e in zip(("surge", "sway", "heave"), errors):
+            assert s[f"{p}{x}_cm"] == pytest.approx(e * np.sqrt(np.mean(sq ** 2)), rel=1e-9)
+            assert s[f"{p}delayed_{x}_cm"] == pytest.approx(0.0, abs=1e-9)
+    assert s["point_heave_std_cm"] == pytest.approx(100 * 3.0 * np.std(wave[span]), rel=1e-9)
+    assert s["point_3d_cm"] == pytest.approx(2.0 * np.sqrt(3.0) * np.sqrt(np.mean(sq ** 2)), rel=1e-9)
+    assert s["point_distance_m"] == pytest.approx(np.sqrt(30.0))
+    # a monitoring point elsewhere than the vessel's point is not scored against it
+    other = score(r, _mru_system((5.0, 2.0, -1.5)), "vessel", delay=0)["mru"]
+    assert mru_point(_mru_system((5.0, 2.0, -1.5)), "mru", "vessel") is None
+    assert "point_heave_cm" not in other and other["heave_cm"] == s["heave_cm"]

@@ -33,6 +33,16 @@ GOALS = {
     **{("GnssAccFusion", f"pos_{a}_cm"): ("≤ 0.5 × raw GNSS (project goal)",
                                          lambda s, a=a: None if f"raw_gnss_{a}_cm" not in s else s[f"pos_{a}_cm"] <= 0.5 * s[f"raw_gnss_{a}_cm"])
        for a in "ned"},
+    # the MotionReferenceUnit: the issue's goals (heave as the HeaveObserver's; surge and sway twice as loose, as
+    # they are for commercial units; the delayed outputs half the real-time error)
+    **{("MotionReferenceUnit", f"{a}_deg"): ("≤ 0.02° (project goal, as the AttitudeEstimator)",
+                                             lambda s, a=a: s[f"{a}_deg"] <= 0.02) for a in ("roll", "pitch")},
+    **{("MotionReferenceUnit", f"{p}{a}_cm"): (f"≤ max(2 cm, {pct:g} % of std) (project goal)",
+                                               lambda s, p=p, a=a, pct=pct: s[f"{p}{a}_cm"] <= max(2.0, pct / 100 * s[f"{p}{a}_std_cm"]))
+       for p in ("", "point_") for a, pct in (("surge", 5.0), ("sway", 5.0), ("heave", 2.5))},
+    **{("MotionReferenceUnit", f"{p}delayed_{a}_cm"): ("≤ ½ × the real-time error (project goal)",
+                                                       lambda s, p=p, a=a: s[f"{p}delayed_{a}_cm"] <= 0.5 * s[f"{p}{a}_cm"])
+       for p in ("", "point_") for a in ("surge", "sway", "heave")},
     # the AHC goals are for the loop fed by a heave estimator (the winch that has vs_ideal/vs_classical)
     ("AhcWinch", "residual_pct"): ("≤ 5 % when fed by the observer (project goal)",
                                    lambda s: None if "vs_ideal" not in s and "vs_classical" not in s else s["residual_pct"] <= 5.0),
@@ -52,6 +62,12 @@ LABELS = {
     "disp_n_cm": "COG north (window centre, delay s late), RMS error [cm]",
     "disp_e_cm": "COG east (window centre, delay s late), RMS error [cm]",
     "disp_d_cm": "COG down (window centre, delay s late), RMS error [cm]",
+    **{f"{p}{d}{a}_cm": f"{a} at the {where}{', delayed' if d else ''}, RMS error [cm]"
+       for p, where in (("", "IMU"), ("point_", "point")) for d in ("", "delayed_") for a in ("surge", "sway", "heave")},
+    **{f"{p}{a}_std_cm": f"true {a} std at the {where} [cm]" for p, where in (("", "IMU"), ("point_", "point"))
+       for a in ("surge", "sway", "heave")},
+    "point_3d_cm": "point position (3-D), RMS length of the error [cm]",
+    "point_distance_m": "point's distance from the IMU [m]",
     "valid_fraction": "fraction of the run with valid output", "scored_s": "time scored [s]",
     "tip_heave_cm": "crane-tip heave std [cm]", "load_heave_cm": "load heave std [cm]",
     "residual_pct": "load heave / tip heave [%]", "tip_motion_cm": "crane-tip vertical motion std, all frequencies [cm]",
@@ -208,6 +224,10 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
                 ax.legend(loc="upper right", ncol=3, fontsize=8)
                 out.append((f"{c}: COG displacement reconstructed from acceleration alone (no GNSS), at the "
                             f"window centre, {delay:g} s behind real time", figure_png(fig)))
+        elif kind == "MotionReferenceUnit" and f"{c}.motion.valid" in fields:
+            fig = _mru_figure(result, system, c, v, plt)
+            if fig is not None:
+                out.append(fig)
     winches = [c.name for c in system.components if c.kind == "AhcWinch" and f"{c.name}.load.d" in fields]
     tip = f"{vessel}.truth.point.d"
     if winches and tip in fields:
@@ -221,6 +241,57 @@ def _figures(result: np.ndarray, system: SystemDescription, vessel: str, plt) ->
         ax.legend(loc="upper right", ncol=3, fontsize=8)
         out.append(("heave compensation: the crane tip and each winch's load, the last minute", figure_png(fig)))
     return out
+
+
+def _mru_figure(result: np.ndarray, system: SystemDescription, c: str, v: str, plt) -> tuple[str, str] | None:
+    """A MotionReferenceUnit at the vessel's point (:func:`~.scoring.mru_point`): surge, sway
+    and heave over the last minute, the truth against the real-time and the delayed outputs
+    (each drawn at the time it refers to), and the 3-D error over the run; None without the
+    point's outputs and truth recorded."""
+    from .scoring import mru_arm, mru_point
+
+    fields = set(result.dtype.names)
+    prefix = mru_point(system, c, v)
+    names = [f"{c}.{prefix}{a}" for a in ("surge", "sway", "heave")] + [f"{v}.truth.point.{a}" for a in "ned"]
+    if prefix is None or not all(n in fields for n in names):
+        return None
+    t = np.asarray(result["time"], dtype=float)
+    valid = np.asarray(result[f"{c}.motion.valid"], dtype=bool)
+    if not valid.any() or len(t) < 3:
+        return None
+    dt = t[1] - t[0]
+    has_delayed = f"{c}.delayed.delay" in fields and f"{c}.{prefix}delayed.heave" in fields
+    lag = int(round(float(result[f"{c}.delayed.delay"][-1]) / dt)) if has_delayed else 0
+    # Jacobi coupling: the row k + 1 output is computed from the vessel's row k; the delayed output
+    # for row k comes lag rows later. The window: the last minute the delayed output has reached.
+    end = len(t) - 1 - lag - 1
+    k = np.arange(max(0, end - int(round(60.0 / dt))), end)
+    k = k[valid[k]]
+    fig, ax = plt.subplots(4, 1, figsize=(10, 9.5))
+    err = np.zeros(len(t) - 1)
+    for i, (axis, ned) in enumerate((("surge", "n"), ("sway", "e"), ("heave", "d"))):
+        truth = np.asarray(result[f"{v}.truth.point.{ned}"], dtype=float)
+        truth = truth - truth[valid].mean()
+        est = np.asarray(result[f"{c}.{prefix}{axis}"], dtype=float)
+        e = est[1:] - truth[:-1]
+        e -= e[valid[1:]].mean()
+        err += e ** 2
+        ax[i].plot(t[k], truth[k], "k", lw=2, alpha=0.4, label="truth")
+        ax[i].plot(t[k], est[k + 1], lw=0.9, label="real time")
+        if has_delayed:
+            delayed = np.asarray(result[f"{c}.{prefix}delayed.{axis}"], dtype=float)
+            ax[i].plot(t[k], delayed[k + 1 + lag], "--", lw=0.9, label=f"delayed (given {lag * dt:g} s later)")
+        ax[i].set_ylabel(f"{axis} [m, {'down' if ned == 'd' else 'level frame'}]")
+        ax[i].legend(loc="upper right", ncol=3, fontsize=8)
+    ax[2].set_xlabel("time [s]")
+    ok = valid[1:]
+    ax[3].plot(t[:-1][ok], 100 * np.sqrt(err[ok]), lw=0.5, color="tab:red")
+    ax[3].set_ylabel("3-D error, real time [cm]")
+    ax[3].set_xlabel("time [s]")
+    distance = float(np.linalg.norm(mru_arm(system, c, prefix)))
+    return (f"{c}: three-axis motion of monitoring point {prefix.rstrip('.')} ({distance:.1f} m from the IMU) "
+            "about its mean, truth against the real-time and the delayed outputs over the last minute the delayed output "
+            "covers, and the real-time 3-D error over the run", figure_png(fig))
 
 
 def accuracy_rows(system: SystemDescription, scores: dict[str, dict[str, float]]) -> list[tuple[str, str, float, str, str]]:

@@ -18,7 +18,20 @@ DisplacementReconstructor   ``disp_n_cm``, ``disp_e_cm``, ``disp_d_cm``: its out
                             mean (a reconstruction from acceleration has no absolute position)
 CentreOfRotation            ``cr_x_m``, ``cr_y_m``, ``cr_z_m`` (truth.cr, when the vessel runs in
                             the independent-rotation-centre mode and ``truth.cr.defined``)
+MotionReferenceUnit         ``roll_deg``, ``pitch_deg`` (truth.roll, truth.pitch; from ``valid``);
+                            from ``motion.valid``: ``surge_cm``, ``sway_cm``, ``heave_cm`` at the
+                            IMU (truth.imu.n/e/d), ``delayed_surge_cm`` … (its ``delayed.*``
+                            against the truth ``delayed.delay`` s earlier), ``*_std_cm`` of the
+                            truth; and the same with a ``point_`` prefix for the monitoring
+                            point whose lever arm is the vessel's point relative to its IMU
+                            (:func:`mru_point`), with ``point_3d_cm`` (the RMS length of the
+                            error vector) and ``point_distance_m`` (the lever arm's length)
 =========================  ====================================================================
+
+The MotionReferenceUnit's surge, sway and heave are in its vessel-level frame (north along its
+mean heading), VesselMotion's truth in its NED (north along the vessel's mean heading): the same
+frame but for the unit's error in the mean heading, which is part of its error. All its
+positions are scored about their means (the filters have no output at zero frequency).
 
 AhcWinch components are scored together, on one span: from ``settle`` s after the
 last AhcController of the system first reports ``valid`` (full compensation) to the end, so the
@@ -60,6 +73,9 @@ METRICS: dict[str, tuple[str, ...]] = {
     "HeaveObserver": ("heave_cm", "heave_std_cm", "point_heave_cm", "point_heave_std_cm"),
     "DisplacementReconstructor": ("disp_n_cm", "disp_e_cm", "disp_d_cm"),
     "CentreOfRotation": ("cr_x_m", "cr_y_m", "cr_z_m"),
+    "MotionReferenceUnit": ("roll_deg", "pitch_deg",
+                            *(f"{p}{d}{a}_{u}" for p in ("", "point_") for d, u in (("", "cm"), ("", "std_cm"), ("delayed_", "cm"))
+                              for a in ("surge", "sway", "heave")), "point_3d_cm", "point_distance_m"),
     "AhcWinch": ("tip_heave_cm", "load_heave_cm", "residual_pct", "tip_motion_cm", "load_motion_cm",
                  "residual_total_pct", "limited_pct", *(f"{n}_pct" for n in LIMIT_FLAGS), "vs_ideal", "vs_classical"),
 }
@@ -75,9 +91,9 @@ def _about_mean(x: np.ndarray) -> np.ndarray:
     return x - x.mean() if x.size else x
 
 
-def _span(result: np.ndarray, comp: str, settle: float) -> np.ndarray:
-    """Boolean mask: valid, and at least ``settle`` s after valid first went true."""
-    valid = np.array(result[f"{comp}.valid"], dtype=bool)   # a copy: the result may be a read-only memory map
+def _span(result: np.ndarray, comp: str, settle: float, flag: str = "valid") -> np.ndarray:
+    """Boolean mask: ``comp.flag`` true, and at least ``settle`` s after it first went true."""
+    valid = np.array(result[f"{comp}.{flag}"], dtype=bool)   # a copy: the result may be a read-only memory map
     if not valid.any():
         return valid
     t = np.asarray(result["time"], dtype=float)
@@ -182,9 +198,76 @@ def score(result: np.ndarray, system: SystemDescription, vessel: str, settle: fl
             m &= np.asarray(result[f"{v}.truth.cr.defined"], dtype=bool)
             for a in "xyz":
                 row[f"cr_{a}_m"] = _rms(f(f"{c}.cr.{a}")[m] - f(f"{v}.truth.cr.{a}")[m])
+        elif kind == "MotionReferenceUnit" and has(f"{c}.roll", f"{v}.truth.roll"):
+            for a in ("roll", "pitch"):
+                row[f"{a}_deg"] = math.degrees(_rms(f(f"{c}.{a}")[m] - f(f"{v}.truth.{a}")[m]))
+            if has(f"{c}.motion.valid"):
+                mm = _span(result, c, settle, "motion.valid")
+                mm[:delay] = False
+                point = mru_point(system, c, v)
+                for prefix, out_prefix, truth in (("", "", "imu"), (point, "point_", "point")):
+                    if prefix is not None and has(f"{c}.{prefix}heave", f"{v}.truth.{truth}.d"):
+                        row.update(_mru_location(f, t, mm, f"{c}.{prefix}", f"{v}.truth.{truth}", out_prefix,
+                                                 f"{c}.delayed.delay" if has(f"{c}.delayed.delay") else None))
+                if "point_surge_cm" in row:
+                    row["point_distance_m"] = float(np.linalg.norm(mru_arm(system, c, point)))
         out[comp.name] = row
     out.update(ahc_scores(result, system, settle))
     return out
+
+
+_MRU_AXES = (("surge", "n"), ("sway", "e"), ("heave", "d"))
+
+
+def _mru_location(f, t: np.ndarray, m: np.ndarray, est: str, truth: str, prefix: str, delay_name: str | None
+                  ) -> dict[str, float]:
+    """A MotionReferenceUnit's metrics [cm] at one location (module docstring): ``est`` is the
+    output prefix (``mru.`` or ``mru.mp1.``), ``truth`` the VesselMotion position prefix,
+    ``f`` the field reader of :func:`score` (the truth at the estimates' time)."""
+    row: dict[str, float] = {}
+    err3 = []
+    for axis, ned in _MRU_AXES:
+        tr = f(f"{truth}.{ned}")[m]
+        e = _about_mean(f(f"{est}{axis}")[m] - tr)
+        err3.append(e)
+        row[f"{prefix}{axis}_cm"] = 100.0 * _rms(e)
+        row[f"{prefix}{axis}_std_cm"] = 100.0 * float(np.std(tr)) if tr.size else math.nan
+    if prefix:
+        row[f"{prefix}3d_cm"] = 100.0 * _rms(np.sqrt(sum(e ** 2 for e in err3)))
+    if delay_name is not None and len(t) > 1:
+        valid = np.flatnonzero(m)
+        if valid.size:
+            lag = int(round(float(f(delay_name)[valid[-1]]) / (t[1] - t[0])))
+            k = valid[valid >= lag]
+            for axis, ned in _MRU_AXES:
+                e = f(f"{est}delayed.{axis}")[k] - f(f"{truth}.{ned}")[k - lag]
+                row[f"{prefix}delayed_{axis}_cm"] = 100.0 * _rms(_about_mean(e))
+    return row
+
+
+def mru_arm(system: SystemDescription, comp: str, prefix: str) -> np.ndarray:
+    """Lever arm [m] of a MotionReferenceUnit's monitoring point ``prefix`` (``mp<i>.``)."""
+    params = next(c for c in system.components if c.name == comp).parameters
+    return np.array([float(params.get(f"{prefix}{a}", 0.0)) for a in "xyz"])
+
+
+def mru_point(system: SystemDescription, comp: str, vessel: str, tol: float = 1e-6) -> str | None:
+    """The output prefix (``mp<i>.``) of the first enabled monitoring point of the
+    MotionReferenceUnit ``comp`` that sits at the VesselMotion ``vessel``'s point (its lever
+    arm equals the vessel's ``point`` minus its ``imu``, within ``tol`` m, body frame), or None.
+    Unset vessel parameters take VesselMotion's defaults."""
+    from ..estimators.mru.params import MAX_POINTS
+    from ..sea.motion_model import PARAMETERS
+
+    defaults = {p.name: p.default for p in PARAMETERS}
+    vp = {**defaults, **next(c for c in system.components if c.name == vessel).parameters}
+    target = np.array([float(vp[f"point.{a}"]) - float(vp[f"imu.{a}"]) for a in "xyz"])
+    params = next(c for c in system.components if c.name == comp).parameters
+    for i in range(1, MAX_POINTS + 1):
+        prefix = f"mp{i}."
+        if params.get(f"{prefix}enabled") and np.all(np.abs(mru_arm(system, comp, prefix) - target) <= tol):
+            return prefix
+    return None
 
 
 def _source(system: SystemDescription, comp: str, var: str) -> tuple[str, str] | None:
