@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, check_choice, check_int, check_vector
-from ..frames import attitude_kinematics, rigid_point_operator, specific_force
+from ..frames import G, attitude_kinematics, rigid_point_operator, specific_force
 from ..variables import Variable, real, resolve, vec
 from .sensors import ANTENNAS, GRADE_FIGURES, IMU_GRADES, Gnss, GnssParams, Imu, ImuParams
 from .vessel import PRESET_NAMES, MotionSeries, RaoTable, check_speed, load_rao_csv, preset_raos
@@ -237,6 +237,17 @@ class VesselMotion:
     params : VesselMotionParams
         Validated parameters; the RAO file (if any) is read here.
 
+    Notes
+    -----
+    Cost per step: one complex exponential per wave component and one matrix-vector product
+    give all 19 DOF values (:meth:`MotionSeries.at`); two small products with the arms'
+    operator and R_nb give the COG, IMU and point, and one more the specific force. These are
+    the numpy calls of :meth:`rigid_body`, :meth:`RigidBodyState.points` and
+    :func:`~marinefmu.frames.specific_force`, on operands of the same layout, so the outputs are
+    theirs bit for bit (the products use the BLAS's fused multiply-adds, which Python floats
+    cannot repeat); they write into arrays made once, and the sums, the IMU's errors and the
+    output list are on Python floats. The antennas are computed only at GNSS epochs.
+
     Examples
     --------
     >>> m = VesselMotion(VesselMotionParams())
@@ -256,7 +267,23 @@ class VesselMotion:
         self._arms = np.array([[0.0, 0.0, 0.0], params.imu.lever_arm, params.point]) - self.cr
         self._ant_arms = ant - self.cr
         self._cr_out = self.cr.copy()
+        self._cr_list: list[float] = self._cr_out.tolist()
+        self._buffers()
         self.reset()
+
+    def _buffers(self) -> None:
+        """Work arrays of the per-step path, made once (their contents never outlive a step)."""
+        self._coef, self._omega_e = self.series.coef, self.series.omega_e
+        self._arg = np.zeros(self._omega_e.size, dtype=complex)  # i ω_e t: real part 0
+        self._arg_imag = self._arg.imag
+        self._phasor = np.empty_like(self._arg)
+        self._x = np.empty(self._coef.shape[0], dtype=complex)
+        self._x_real = self._x.real
+        self._body = np.empty((len(self._arms), 9))
+        self._body_rows = self._body.reshape(-1, 3)
+        self._arms_n = np.empty_like(self._body_rows)
+        self._acc_minus_g = np.empty(3)
+        self._f_imu = np.empty(3)
 
     def reset(self) -> None:
         """Return to t = 0 with freshly seeded sensor noise."""
@@ -264,6 +291,7 @@ class VesselMotion:
         self.imu = Imu(self.params.imu, np.random.default_rng(imu_seed))
         self.gnss = Gnss(self.params.gnss, np.random.default_rng(gnss_seed))
         self.gnss_new = False
+        self._gnss_out: list[float] = self.gnss.positions.tolist()
 
     def rigid_body(self, t: float) -> RigidBodyState:
         """Exact rigid-body state of the reference point at time ``t`` [s]."""
@@ -293,21 +321,43 @@ class VesselMotion:
         return self._outputs(t, None)
 
     def _outputs(self, t: float, dt: float | None) -> list[float]:
-        s = self.rigid_body(t)
-        pts = s.points(self._arms)  # rows: COG, IMU, point
-        f_imu = specific_force(s.rot, pts[1, 6:9])
+        # The sum of sinusoids and the three products with R_nb and the arms' operator are the
+        # operations of rigid_body(), RigidBodyState.points() and specific_force() (same numpy
+        # calls on operands of the same layout), into buffers made in _buffers(); the sums
+        # and the sensors' arithmetic are on Python floats, elementwise as before.
+        np.multiply(self._omega_e, t, out=self._arg_imag)
+        np.exp(self._arg, out=self._phasor)
+        np.matmul(self._coef, self._phasor, out=self._x)
+        x = self._x_real.tolist()
+        euler = x[3:6]
+        rot, rate, ang_acc = attitude_kinematics(euler, x[9:12], x[15:18])
+        np.matmul(self._arms, rigid_point_operator(rate, ang_acc).T, out=self._body)
+        np.matmul(self._body_rows, rot.T, out=self._arms_n)
+        n = self._arms_n.tolist()  # rows: (offset, velocity, acceleration) of COG, IMU, point
+        p0, p1, p2, v0, v1, v2, a0, a1, a2 = x[0], x[1], x[2], x[6], x[7], x[8], x[12], x[13], x[14]
+        pts = []
+        for i in (0, 3, 6):
+            r, v, a = n[i], n[i + 1], n[i + 2]
+            pts.append([r[0] + p0, r[1] + p1, r[2] + p2, v[0] + v0, v[1] + v1, v[2] + v2, a[0] + a0, a[1] + a1, a[2] + a2])
+        imu = pts[1]
+        d = self._acc_minus_g
+        d[0], d[1], d[2] = imu[6], imu[7], imu[8] - G  # a_n − g_n
+        np.matmul(rot.T, d, out=self._f_imu)
+        f_imu = self._f_imu.tolist()
+        bias = self.imu.bias_values()
         if dt is None:
-            meas = np.concatenate((f_imu, s.rate)) + self.imu.bias
+            meas = [f_imu[0] + bias[0], f_imu[1] + bias[1], f_imu[2] + bias[2],
+                    rate[0] + bias[3], rate[1] + bias[4], rate[2] + bias[5]]
         else:
-            meas = self.imu.measure(f_imu, s.rate, dt)
+            meas = self.imu.measure_values(f_imu, rate, dt)
+            bias = self.imu.bias_values()
             k = self.gnss.epoch_due(t)
             self.gnss_new = k is not None
             if k is not None:
                 self.gnss.measure(k, self.antenna_positions(k / self.params.gnss.rate))
-        return np.concatenate(
-            (meas, self.gnss.positions, pts[0], s.euler, s.rate, s.ang_acc, pts[1], f_imu, pts[2],
-             self._cr_out, self.imu.bias, (s.wave,))
-        ).tolist()
+                self._gnss_out = self.gnss.positions.tolist()
+        return [*meas, *self._gnss_out, *pts[0], *euler, *rate, *ang_acc, *imu, *f_imu, *pts[2],
+                *self._cr_list, *bias, x[18]]
 
     def boolean_outputs(self) -> list[bool]:
         """Values ordered as :data:`BOOLEAN_OUTPUTS`."""
@@ -322,6 +372,7 @@ class VesselMotion:
         self.imu.set_state(state["imu"])
         self.gnss.set_state(state["gnss"])
         self.gnss_new = bool(state["gnss_new"])
+        self._gnss_out = self.gnss.positions.tolist()
 
 
 def simulate_record(params: VesselMotionParams, duration: float, dt: float = 0.01) -> dict[str, np.ndarray]:

@@ -152,6 +152,11 @@ class ImuParams:
 class Imu:
     """Adds the configured errors to true specific force and angular rate.
 
+    Cost per step: :meth:`measure_values` draws the step's 12 normal numbers into a buffer made
+    once and works on Python floats; the Gauss–Markov factor φ = e^{−Δt/τ} and the noise scales
+    are computed again only when Δt changes (they are functions of Δt alone, so the numbers are
+    those of evaluating them every step).
+
     Parameters
     ----------
     params : ImuParams
@@ -166,22 +171,64 @@ class Imu:
         self._const = np.concatenate([params.acc_bias, params.gyro_bias])
         self._sigma_b = np.repeat([params.acc_bias_instability, params.gyro_bias_instability], 3)
         self._density = np.repeat([params.acc_noise, params.gyro_noise], 3)
-        self.gm_bias = self._sigma_b * self._rng.standard_normal(6)
+        self._const_l: list[float] = self._const.tolist()
+        self._sigma_l: list[float] = self._sigma_b.tolist()
+        self._density_l: list[float] = self._density.tolist()
+        self._w = np.empty(12)
+        self._dt: float | None = None  # the step the factors below belong to
+        self._phi = 0.0
+        self._gm_scale: list[float] = []
+        self._noise_scale: list[float] = []
+        self._gm: list[float] = (self._sigma_b * self._rng.standard_normal(6)).tolist()
+
+    @property
+    def gm_bias(self) -> np.ndarray:
+        """(6,) Gauss–Markov part of the bias [acc (m/s²), gyro (rad/s)], body frame (a copy)."""
+        return np.array(self._gm)
+
+    @gm_bias.setter
+    def gm_bias(self, value: Any) -> None:
+        self._gm = [float(v) for v in value]
 
     @property
     def bias(self) -> np.ndarray:
         """(6,) total bias [acc (m/s²), gyro (rad/s)], body frame."""
-        return self._const + self.gm_bias
+        return np.array(self.bias_values())
 
-    def measure(self, f_true: np.ndarray, w_true: list[float], dt: float) -> np.ndarray:
-        """Advance the bias by ``dt`` [s] and return (6,) [f_b (m/s²), ω_b (rad/s)] measured."""
+    def bias_values(self) -> list[float]:
+        """:attr:`bias` as 6 Python floats."""
+        c, g = self._const_l, self._gm
+        return [c[0] + g[0], c[1] + g[1], c[2] + g[2], c[3] + g[3], c[4] + g[4], c[5] + g[5]]
+
+    def _factors(self, dt: float) -> None:
+        """φ = e^{−Δt/τ}, σ_b √(1−φ²) and N/√Δt for step ``dt`` [s]."""
         phi = math.exp(-dt / self.params.bias_tau)
-        w = self._rng.standard_normal(12)
-        self.gm_bias = phi * self.gm_bias + self._sigma_b * math.sqrt(1.0 - phi * phi) * w[:6]
-        true = np.empty(6)
-        true[:3] = f_true
-        true[3:] = w_true
-        return true + self._const + self.gm_bias + self._density / math.sqrt(dt) * w[6:]
+        s = math.sqrt(1.0 - phi * phi)
+        r = math.sqrt(dt)
+        self._phi = phi
+        self._gm_scale = [sb * s for sb in self._sigma_l]
+        self._noise_scale = [d / r for d in self._density_l]
+        self._dt = dt
+
+    def measure(self, f_true: Any, w_true: Any, dt: float) -> np.ndarray:
+        """Advance the bias by ``dt`` [s] and return (6,) [f_b (m/s²), ω_b (rad/s)] measured.
+
+        .. math:: b_k = φ b_{k−1} + σ_b \\sqrt{1−φ^2}\\, w_k,\\quad
+                  y_k = x_k + b_c + b_k + N/\\sqrt{Δt}\\, v_k,\\quad φ = e^{−Δt/τ}
+        """
+        return np.array(self.measure_values(f_true, w_true, dt))
+
+    def measure_values(self, f_true: Any, w_true: Any, dt: float) -> list[float]:
+        """:meth:`measure` on and to Python floats: ``f_true`` and ``w_true`` are 3 values each."""
+        if dt != self._dt:
+            self._factors(dt)
+        w = self._rng.standard_normal(out=self._w).tolist()
+        phi, gs, ns, c, g = self._phi, self._gm_scale, self._noise_scale, self._const_l, self._gm
+        g = [phi * g[i] + gs[i] * w[i] for i in range(6)]
+        self._gm = g
+        return [f_true[0] + c[0] + g[0] + ns[0] * w[6], f_true[1] + c[1] + g[1] + ns[1] * w[7],
+                f_true[2] + c[2] + g[2] + ns[2] * w[8], w_true[0] + c[3] + g[3] + ns[3] * w[9],
+                w_true[1] + c[4] + g[4] + ns[4] * w[10], w_true[2] + c[5] + g[5] + ns[5] * w[11]]
 
     def measure_many(self, f_true: np.ndarray, w_true: np.ndarray, dt: float) -> np.ndarray:
         """:meth:`measure` at each of n steps of ``dt`` [s], vectorised: the same numbers, drawn
@@ -214,12 +261,12 @@ class Imu:
 
     def get_state(self) -> dict:
         """JSON-serialisable state (generator and bias)."""
-        return {"rng": self._rng.bit_generator.state, "gm_bias": self.gm_bias.tolist()}
+        return {"rng": self._rng.bit_generator.state, "gm_bias": list(self._gm)}
 
     def set_state(self, state: dict) -> None:
         """Restore a state from :meth:`get_state`."""
         self._rng.bit_generator.state = state["rng"]
-        self.gm_bias = np.array(state["gm_bias"], dtype=float)
+        self.gm_bias = state["gm_bias"]
 
 
 @dataclass(frozen=True)
