@@ -46,3 +46,26 @@ def test_idle_fmus_have_the_variables_of_the_real_ones_and_do_nothing(fmu_dir, t
     r = SystemRunner(sysd, idle).run(record=["vessel.imu.gyro.x", "att.roll", "att.valid"], progress=False)
     assert r.size == 51
     assert np.all(r["vessel.imu.gyro.x"] == 0.0) and np.all(r["att.roll"] == 0.0) and not r["att.valid"].any()
+
+
+def test_the_speed_table_splits_each_base_step_into_components_and_the_rest():
+    """Per component the in-process and FMI figures side by side; the master's row is the wall
+    time per base step minus the components' own; the base step is 1e6 × wall / steps."""
+    from marinefmu.bench.system import markdown, speed_table
+
+    speed = {"fmpy": {"wall_s": 60.0, "duration_s": 600.0, "rtf": 10.0, "peak_rss_mb": 180.0,
+                      "step_us": {"vessel": 400.0, "att": 300.0}},
+             "python": {"wall_s": 48.0, "duration_s": 600.0, "rtf": 12.5, "peak_rss_mb": 170.0,
+                        "step_us": {"vessel": 320.0, "att": 300.0}},
+             "libcosim": {"wall_s": 100.0, "duration_s": 600.0, "rtf": 6.0, "peak_rss_mb": 190.0, "step_us": None},
+             "idle_fmus": {"wall_s": 4.0, "duration_s": 600.0, "rtf": 150.0, "peak_rss_mb": 100.0}}
+    rows = {r["component"]: r for r in speed_table(speed)}
+    assert list(rows) == ["vessel", "att", "master and calls", "base step"]
+    assert rows["vessel"]["fmi_over_in_process"] == pytest.approx(1.25)
+    assert rows["base step"]["fmi_us"] == pytest.approx(1000.0) and rows["base step"]["in_process_us"] == pytest.approx(800.0)
+    assert rows["master and calls"]["fmi_us"] == pytest.approx(300.0)
+    assert rows["master and calls"]["in_process_us"] == pytest.approx(180.0)
+    text = markdown({"speed": speed, "table": list(rows.values()),
+                     "floor_over": {e: 150.0 / speed[e]["rtf"] for e in ("fmpy", "python", "libcosim")}})
+    assert "| FMPy runner (FMI) | 60.0 s | 10.0 | 15.0 | 180 MB |" in text
+    assert "| master and calls | 180 | 300 | 1.67 |" in text

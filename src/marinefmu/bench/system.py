@@ -19,6 +19,7 @@ mean wall time per base step in its ``doStep`` [µs] (``SystemRunner.step_second
 from __future__ import annotations
 
 import json
+import math
 import resource
 import subprocess
 import sys
@@ -194,10 +195,48 @@ def master_floor(fmu_dir: Path, work: Path, duration: float = 600.0) -> dict:
     return r
 
 
+#: Goals of the ``system`` part's speed (issue: the whole system at a 100 Hz base step): real-time
+#: factors under the FMPy runner and under libcosim, the FMI / in-process time ratio, and the peak
+#: memory of the 3-hour run [MB].
+SPEED_GOALS = {"rtf_fmpy": 50.0, "rtf_libcosim": 25.0, "fmi_over_in_process": 1.1, "peak_rss_mb_3h": 500.0}
+
+
+def speed_table(speed: dict) -> list[dict]:
+    """Rows of the speed table from :func:`whole_system`'s ``speed`` entry: per component, its
+    mean wall time per base step in ``doStep`` [µs] in-process (``python``) and through FMI
+    (``fmpy``), and their ratio; then the rest of each engine's base step (the master's exchange,
+    recording and FMI calls: wall time per base step minus the components' own), and the whole
+    base step (µs per base step = 1e6 × step / real-time factor)."""
+    step = _system(None, None).step
+    rows = []
+    fmi, inproc = speed["fmpy"].get("step_us") or {}, speed["python"].get("step_us") or {}
+    for comp in fmi:
+        rows.append({"component": comp, "in_process_us": inproc.get(comp, math.nan), "fmi_us": fmi[comp],
+                     "fmi_over_in_process": fmi[comp] / inproc[comp] if inproc.get(comp) else math.nan})
+    base = {e: 1e6 * speed[e]["wall_s"] / (speed[e]["duration_s"] / step) for e in ("python", "fmpy")}
+    rest = {e: base[e] - sum((speed[e].get("step_us") or {}).values()) for e in base}
+    rows.append({"component": "master and calls", "in_process_us": rest["python"], "fmi_us": rest["fmpy"],
+                 "fmi_over_in_process": rest["fmpy"] / rest["python"]})
+    rows.append({"component": "base step", "in_process_us": base["python"], "fmi_us": base["fmpy"],
+                 "fmi_over_in_process": base["fmpy"] / base["python"]})
+    return rows
+
+
+def first_second(fmu_dir: Path, work: Path) -> dict:
+    """The first second of a run under the FMPy runner, in a fresh process: ``wall_s`` from
+    loading the FMUs (unzip, instantiate, initialise) to the end of 1 simulated second, and
+    ``process_s``, the whole worker process (interpreter start and imports included)."""
+    t0 = time.perf_counter()
+    r = run_isolated("fmpy", fmu_dir, 1.0, work / "first_second", scored=False)
+    return {"wall_s": r["wall_s"], "process_s": time.perf_counter() - t0}
+
+
 def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_duration: float = 3 * 3600.0) -> dict:
     """The bench part ``system``: accuracy per sea (:func:`system_accuracy`), speed of the three
-    engines on the default sea (``duration`` s each) with the FMI / in-process ratio, and peak
-    memory of a ``long_duration`` run under the FMPy runner (results streamed)."""
+    engines on the default sea (``duration`` s each) with the FMI / in-process ratio, the floor
+    (:func:`master_floor`) and each engine's ratio to it, the per-component table
+    (:func:`speed_table`), the first second (:func:`first_second`), and peak memory of a
+    ``long_duration`` run under the FMPy runner (results streamed)."""
     result: dict = {"seas": system_accuracy(fmu_dir, work, duration), "speed": {}}
     for engine in ENGINES:
         r = run_isolated(engine, fmu_dir, duration, work / f"speed_{engine}")
@@ -209,8 +248,21 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
     result["speed"]["idle_fmus"] = master_floor(fmu_dir, work, duration)
     speed = result["speed"]
     result["fmi_over_in_process"] = speed["python"]["rtf"] / speed["fmpy"]["rtf"]
+    result["floor_over"] = {e: speed["idle_fmus"]["rtf"] / speed[e]["rtf"] for e in ENGINES}
+    result["table"] = speed_table(speed)
+    goals = SPEED_GOALS
     print(f"FMI / in-process time ratio (FMPy runner / same code without FMI): {result['fmi_over_in_process']:.2f} "
-          "(project goal <= 1.5)", flush=True)
+          f"(project goal <= {goals['fmi_over_in_process']:g})", flush=True)
+    print(f"real-time factor: FMPy runner {speed['fmpy']['rtf']:.1f} (goal >= {goals['rtf_fmpy']:g}), libcosim "
+          f"{speed['libcosim']['rtf']:.1f} (goal >= {goals['rtf_libcosim']:g}); the floor's over each engine's: "
+          + ", ".join(f"{e} {v:.1f}" for e, v in result["floor_over"].items()), flush=True)
+    print("µs per base step, in-process / through FMI (FMPy runner) / ratio:", flush=True)
+    for row in result["table"]:
+        print(f"  {row['component']:18s} {row['in_process_us']:7.0f} {row['fmi_us']:7.0f} "
+              f"{row['fmi_over_in_process']:6.2f}", flush=True)
+    result["first_second"] = first_second(fmu_dir, work)
+    print(f"first second under the FMPy runner: {result['first_second']['wall_s']:.2f} s from loading the FMUs, "
+          f"{result['first_second']['process_s']:.2f} s for the whole process", flush=True)
     if long_duration:
         r = run_isolated("fmpy", fmu_dir, long_duration, work / "long", scored=False)
         r.pop("scores", None)
@@ -218,9 +270,29 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
         result["long_run"] = r
         print(f"system, {long_duration / 3600:g} h under the FMPy runner, results streamed to disk: "
               f"{r['wall_s']:.0f} s (real-time factor {r['rtf']:.1f}), peak memory {r['peak_rss_mb']:.0f} MB "
-              "(project goal <= 500 MB)", flush=True)
-    result["goals"] = {"rtf_fmpy": 100.0, "fmi_over_in_process": 1.5, "peak_rss_mb_3h": 500.0}
+              f"(project goal <= {goals['peak_rss_mb_3h']:g} MB)", flush=True)
+    result["goals"] = dict(goals)
+    print("the docs' speed tables:\n" + markdown(result), flush=True)
     return result
+
+
+def markdown(data: dict) -> str:
+    """The docs' speed table (Markdown) from :func:`whole_system`'s result."""
+    speed = data["speed"]
+    lines = ["| engine | wall time | real-time factor | floor's factor / this | peak memory |",
+             "|---|---:|---:|---:|---:|"]
+    names = {"fmpy": "FMPy runner (FMI)", "python": "the same slave code in-process, without FMI",
+             "libcosim": "OSP libcosim (sampled every second)", "idle_fmus": "FMPy runner, FMUs whose `doStep` does nothing"}
+    for e, label in names.items():
+        r = speed[e]
+        ratio = data["floor_over"].get(e)
+        lines.append(f"| {label} | {r['wall_s']:.1f} s | {r['rtf']:.1f} | {'—' if ratio is None else f'{ratio:.1f}'} | "
+                     f"{r['peak_rss_mb']:.0f} MB |")
+    lines += ["", "| component | in-process [µs] | through FMI [µs] | FMI / in-process |", "|---|---:|---:|---:|"]
+    for row in data["table"]:
+        lines.append(f"| {row['component']} | {row['in_process_us']:.0f} | {row['fmi_us']:.0f} | "
+                     f"{row['fmi_over_in_process']:.2f} |")
+    return "\n".join(lines)
 
 
 def main(argv: list[str]) -> None:
