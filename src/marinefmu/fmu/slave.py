@@ -24,6 +24,13 @@ made by their import when they run again (:meth:`SlaveIO.rerun`) instead of maki
 one, and :class:`SlaveIO` drops repeated ``sys.path`` entries. What remains (the MRO lists
 and class-name strings) is measured by ``marinefmu bench`` (the FMU contract page).
 
+**Reading outputs.** A master reads the real outputs of every FMU at every step, and
+pythonfmu's ``get_real`` looks up each variable, checks its type and calls its getter. Each
+:class:`SlaveIO` therefore gives its slave a ``get_real`` that reads registered real outputs
+from :attr:`SlaveIO.real_out` by value reference and hands any other request to pythonfmu's
+(:meth:`SlaveIO._real_output_reader`): the values returned are the same. Its ``set_real``
+stores real inputs in :attr:`SlaveIO.inputs` the same way (:meth:`SlaveIO._real_input_writer`).
+
 **The estimators' own log.** What an estimator reports through :mod:`logging` while a slave
 steps it (a heave observer that finds no sea, a centre of rotation with no rotation to see,
 a bias step found) goes to that instance's FMU log as a warning, at the step's time: one
@@ -128,26 +135,34 @@ class SlaveIO:
         self.units: dict[str, str] = {v.name: v.unit for v in (*parameters, *inputs, *outputs, *boolean_outputs)}
         for v in parameters:
             self._register(v, Fmi2Causality.parameter, Fmi2Variability.fixed, self.params)
+        in_index: dict[int, str] = {}  # value reference → name of a real input
         for v in inputs:
-            self._register(v, Fmi2Causality.input, Fmi2Variability.continuous if v.kind == "real" else Fmi2Variability.discrete, self.inputs)
+            vr = self._register(v, Fmi2Causality.input, Fmi2Variability.continuous if v.kind == "real" else Fmi2Variability.discrete, self.inputs)
+            if v.kind == "real":
+                in_index[vr] = v.name
+        slave.set_real = self._real_input_writer(slave.set_real, in_index)
+        out_index: dict[int, int] = {}  # value reference → index in real_out
         for i, v in enumerate(outputs):
-            slave.register_variable(Real(v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
-                                         description=_describe(v), getter=self._item_getter(self.real_out, i)), nested=False)
+            var = Real(v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+                       description=_describe(v), getter=self._item_getter(self.real_out, i))
+            slave.register_variable(var, nested=False)
+            out_index[var.value_reference] = i
+        slave.get_real = self._real_output_reader(slave.get_real, out_index)
         for i, v in enumerate(boolean_outputs):
             slave.register_variable(_FMI_TYPES[v.kind](v.name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
                                                        description=_describe(v), getter=self._item_getter(self.bool_out, i)), nested=False)
 
-    def _register(self, v: Variable, causality: Fmi2Causality, variability: Fmi2Variability, store: dict) -> None:
+    def _register(self, v: Variable, causality: Fmi2Causality, variability: Fmi2Variability, store: dict) -> int:
+        """Register ``v`` with a getter and setter on ``store``; return its value reference."""
         cast = _CAST[v.kind]
 
         def setter(value: Any, name: str = v.name) -> None:
             store[name] = cast(value)
 
-        self.slave.register_variable(
-            _FMI_TYPES[v.kind](v.name, causality=causality, variability=variability, description=_describe(v),
-                               getter=lambda name=v.name: store[name], setter=setter),
-            nested=False,
-        )
+        var = _FMI_TYPES[v.kind](v.name, causality=causality, variability=variability, description=_describe(v),
+                                 getter=lambda name=v.name: store[name], setter=setter)
+        self.slave.register_variable(var, nested=False)
+        return var.value_reference
 
     @staticmethod
     def rerun(namespace: dict[str, Any], name: str) -> type:
@@ -169,6 +184,38 @@ class SlaveIO:
     @staticmethod
     def _item_getter(values: list, i: int) -> Callable[[], Any]:
         return lambda: values[i]
+
+    def _real_output_reader(self, get_real: Callable[[list[int]], list[float]], index: dict[int, int]) -> Callable[[list[int]], list[float]]:
+        """The slave's ``get_real``: a read of real outputs only (what a master does every step)
+        indexes :attr:`real_out` directly; any other read (an input, a parameter, a value
+        reference of another type) goes to pythonfmu's own ``get_real``, which gives the same
+        values, the same ``float`` conversion and the same TypeError."""
+        values = self.real_out
+
+        def read(vrs: list[int]) -> list[float]:
+            try:
+                return [float(values[index[vr]]) for vr in vrs]
+            except (KeyError, TypeError):
+                return get_real(vrs)
+
+        return read
+
+    def _real_input_writer(self, set_real: Callable[[list[int], list[float]], None], index: dict[int, str]) -> Callable[[list[int], list[float]], None]:
+        """The slave's ``set_real``: real inputs (what a master sets every step) are stored in
+        :attr:`inputs` directly, as their setters would (``float(value)``); from the first value
+        reference that is not a real input on, the rest of the call goes to pythonfmu's own
+        ``set_real`` (parameters, type errors)."""
+        store = self.inputs
+
+        def write(vrs: list[int], values: list[float]) -> None:
+            for k, (vr, value) in enumerate(zip(vrs, values)):
+                name = index.get(vr)
+                if name is None:
+                    set_real(list(vrs)[k:], list(values)[k:])
+                    return
+                store[name] = float(value)
+
+        return write
 
     def build(self, factory: Callable[[dict[str, Any]], M]) -> M | None:
         """Build the model from the parameter values; on refusal log it and return None.
