@@ -154,3 +154,26 @@ def test_a_step_size_change_restarts_with_a_warning(short):
         mru.step(gyro[k], acc[k], DT)
     r = mru.step(gyro[100], acc[100], 2 * DT)
     assert "step size changed" in r.warning and not r.valid and mru.k == 1
+
+
+def test_the_level_rotation_and_the_scalar_low_pass_are_the_general_ones_written_out():
+    """``level_rotation`` is Rz(ψ̄)ᵀ R_nb (to rounding), and ``push_float`` the vector low-pass
+    on one number bit for bit, its state in the vector's format."""
+    import math
+
+    from marinefmu.estimators.mru.level_frame import SlowLowPass, level_rotation, yaw_rotation
+    from marinefmu.frames import rot_nb
+
+    for yaw_ref, angles in ((0.3, (0.05, -0.02, 1.1)), (-2.9, (0.2, 0.1, -3.0)), (math.pi, (0.0, 0.0, 0.0))):
+        r = rot_nb(*angles)
+        np.testing.assert_allclose(level_rotation(yaw_ref, r), yaw_rotation(yaw_ref) @ r, rtol=0, atol=1e-15)
+    rng = np.random.default_rng(4)
+    x = rng.normal(size=500)
+    vector, scalar = SlowLowPass(30.0), SlowLowPass(30.0)
+    for k, v in enumerate(x):
+        assert scalar.push_float(float(v), 0.01) == vector.push(np.array([v]), 0.01)[0]
+        if k == 250:
+            assert scalar.get_state() == vector.get_state()
+            restored = SlowLowPass(30.0)
+            restored.set_state(scalar.get_state(), scalar=True)
+            scalar = restored

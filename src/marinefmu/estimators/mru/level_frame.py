@@ -53,7 +53,7 @@ class SlowLowPass:
     def __init__(self, tau: float, from_zero: bool = False) -> None:
         self.tau = tau
         self.from_zero = from_zero
-        self.stages: np.ndarray | None = None       # (2, …) the two stages' outputs
+        self.stages: np.ndarray | list[float] | None = None   # (2, …) the two stages' outputs
         self.dt, self.alpha = math.nan, 0.0         # the step the coefficient was computed for
 
     def push(self, x: np.ndarray, dt: float) -> np.ndarray:
@@ -69,19 +69,53 @@ class SlowLowPass:
         self.stages[1] += alpha * (self.stages[0] - self.stages[1])
         return self.stages[1].copy()
 
-    def get_state(self) -> list | None:
-        """JSON-serialisable state."""
-        return None if self.stages is None else self.stages.tolist()
+    def push_float(self, x: float, dt: float) -> float:
+        """:meth:`push` for one number, on Python floats: the same operations in the same order,
+        so the same result bit for bit, without a numpy array per step."""
+        if self.stages is None:
+            start = 0.0 if self.from_zero else float(x)
+            self.stages = [start, start]
+            if not self.from_zero:
+                return start
+        if dt != self.dt:
+            self.dt, self.alpha = dt, 1.0 - math.exp(-dt / self.tau)
+        s0, s1 = self.stages
+        s0 += self.alpha * (x - s0)
+        s1 += self.alpha * (s0 - s1)
+        self.stages = [s0, s1]
+        return s1
 
-    def set_state(self, s: list | None) -> None:
-        """Restore a state from :meth:`get_state`."""
-        self.stages = None if s is None else np.array(s, dtype=float)
+    def get_state(self) -> list | None:
+        """JSON-serialisable state (a scalar's as a vector of one)."""
+        if self.stages is None:
+            return None
+        return [[v] for v in self.stages] if isinstance(self.stages, list) else self.stages.tolist()
+
+    def set_state(self, s: list | None, scalar: bool = False) -> None:
+        """Restore a state from :meth:`get_state`; ``scalar`` for one pushed with :meth:`push_float`."""
+        if s is None:
+            self.stages = None
+        elif scalar:
+            self.stages = [float(v[0]) for v in s]
+        else:
+            self.stages = np.array(s, dtype=float)
 
 
 def yaw_rotation(yaw: float) -> np.ndarray:
     """Rz(ψ)ᵀ [3 × 3]: NED (or any frame turned by ψ about down) to the frame ψ further on."""
     c, s = math.cos(yaw), math.sin(yaw)
     return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def level_rotation(yaw_ref: float, rot_nb: np.ndarray) -> np.ndarray:
+    """R_hb = Rz(ψ̄)ᵀ R_nb [3 × 3] (:func:`yaw_rotation` times ``rot_nb``), written out: its rows
+    are cos ψ̄ r₀ + sin ψ̄ r₁, cos ψ̄ r₁ − sin ψ̄ r₀ and r₂ of R_nb's rows r."""
+    c, s = math.cos(yaw_ref), math.sin(yaw_ref)
+    out = np.empty((3, 3))
+    np.add(c * rot_nb[0], s * rot_nb[1], out=out[0])
+    np.subtract(c * rot_nb[1], s * rot_nb[0], out=out[1])
+    out[2] = rot_nb[2]
+    return out
 
 
 def unwrap(previous: float, yaw: float) -> float:

@@ -33,7 +33,9 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    in the level frame of the mean heading either way.
 
 What runs when: every step, the attitude, one 3 × 3 rotation, four FIR outputs of L + 1
-running-sum reads each, and the points' arms; every second, each filter's bias-step search;
+running-sum reads each, and the points' arms (one (2 × W)·(W × 3P) product for their rates and
+accelerations; the level frame's yaw reference and rows on Python floats, no array per
+scalar); every second, each filter's bias-step search;
 first after ``motion.window`` s and then every :data:`DESIGN_ROUNDS` × ``motion.peak_interval``
 s, each filter's Wiener design, the four a quarter of an interval apart (on average one
 design per interval in all, as the HeaveObserver), so that no step designs more than one.
@@ -59,7 +61,7 @@ from ..attitude.estimator import AttitudeEstimator, AttitudeResult
 from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis
 from ..samples import MAX_YAW
-from .level_frame import SlowLowPass, derivative_weights, unwrap, yaw_rotation
+from .level_frame import SlowLowPass, derivative_weights, level_rotation, unwrap
 from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
@@ -83,8 +85,17 @@ def yaw_filter_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
 
 def euler_yaw_rate(gyro: Any, att: AttitudeResult) -> float:
     """ψ̇ = (sin φ ω_y + cos φ ω_z) / cos θ [rad/s] from the body rate less the estimated bias."""
-    w = np.asarray(gyro, dtype=float) - np.asarray(att.gyro_bias)
-    return float((math.sin(att.roll) * w[1] + math.cos(att.roll) * w[2]) / math.cos(att.pitch))
+    w_y = float(gyro[1]) - float(att.gyro_bias[1])
+    w_z = float(gyro[2]) - float(att.gyro_bias[2])
+    return (math.sin(att.roll) * w_y + math.cos(att.roll) * w_z) / math.cos(att.pitch)
+
+
+def _at_points(imu: np.ndarray, arms: np.ndarray) -> np.ndarray:
+    """(P + 1, 3): the IMU's row, then the IMU's plus each point's arm term."""
+    out = np.empty((len(arms) + 1, 3))
+    out[0] = imu
+    np.add(imu, arms, out=out[1:])
+    return out
 
 
 class MotionReferenceUnit:
@@ -139,6 +150,7 @@ class MotionReferenceUnit:
         self.weights = derivative_weights(dt)
         self.lag_steps = self.axes[0].lag_steps
         self.arm_ring = np.zeros((max(self.lag_steps + 1, self.weights.shape[1]), len(self.arms), 3))
+        self._ring_offsets = {self.weights.shape[1]: np.arange(self.weights.shape[1])}
         self.delayed_from = m.window + m.peak_interval * 3.0 / 4.0 + self.axes[0].delay
 
     @property
@@ -175,8 +187,7 @@ class MotionReferenceUnit:
         a_h = None
         if good:
             self.yaw = att.yaw if self.yaw is None else unwrap(self.yaw, att.yaw)
-            ref = float(self.yaw_ref.push(np.array([self.yaw]), dt)[0])
-            self.rot = yaw_rotation(ref) @ quat_to_rot(np.asarray(att.q))
+            self.rot = level_rotation(self.yaw_ref.push_float(self.yaw, dt), quat_to_rot(att.q))
             a_h = self.rot @ np.asarray(acc, dtype=float)
             a_h[2] += G
         outs = [axis.push(None if a_h is None else float(a_h[i])) for i, axis in enumerate(self.axes)]
@@ -198,23 +209,33 @@ class MotionReferenceUnit:
         warning = restart or att.warning or heading_warning
         angles_valid = att.valid and heading_warning is None
         rows = len(self.arms) + 1
-        if any(o is None for o in outs) or (yaw_wave is None and len(self.arms)):
+        if outs[0] is None or outs[1] is None or outs[2] is None or (yaw_wave is None and len(self.arms)):
             zeros = np.zeros((rows, 3))
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros.copy(), np.zeros(rows), zeros.copy(),
                              self.delay, heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
-        o = np.array(outs)                                                   # (3 axes, 4)
+        o = np.array(outs).T                       # (4, 3 axes): position, rate, delayed position, ...
         w = self.weights.shape[1]
-        recent = self.arm_ring[(self.k - w + np.arange(w)) % n]              # (W, P, 3), oldest first
-        d_rate = np.tensordot(self.weights, recent, axes=(1, 0)) if self.k >= w else np.zeros((2, len(self.arms), 3))
+        if self.k >= w:
+            recent = self.arm_ring.take(self._ring_index(w, n), axis=0)      # (W, P, 3), oldest first
+            d_rate = (self.weights @ recent.reshape(w, -1)).reshape(2, len(self.arms), 3)
+        else:
+            d_rate = np.zeros((2, len(self.arms), 3))
         arm_now = self.arm_ring[(self.k - 1) % n]
         arm_then = self.arm_ring[(self.k - 1 - self.lag_steps) % n]
-        position = np.vstack([o[:, 0], o[:, 0] + arm_now])
-        velocity = np.vstack([o[:, 1], o[:, 1] + d_rate[0]])
-        heave_acc = np.concatenate([[self.heave_acc], self.heave_acc + d_rate[1][:, 2]])
-        delayed = np.vstack([o[:, 2], o[:, 2] + arm_then])
+        position, velocity, delayed = (_at_points(o[i], arm) for i, arm in ((0, arm_now), (1, d_rate[0]), (2, arm_then)))
+        heave_acc = np.empty(rows)
+        heave_acc[0] = self.heave_acc
+        np.add(self.heave_acc, d_rate[1][:, 2], out=heave_acc[1:])
         return MruResult(att.roll, att.pitch, yaw_out, position, velocity, heave_acc, delayed, self.delay,
                          heave_axis.peak_period, angles_valid, good, good and self.k * dt >= self.delayed_from,
                          heading_used, warning)
+
+    def _ring_index(self, w: int, n: int) -> np.ndarray:
+        """Indices into the arm ring of the last ``w`` of its ``n`` samples, oldest first."""
+        start = (self.k - w) % n
+        index = self._ring_offsets[w] + start
+        index[index >= n] -= n
+        return index
 
     def _heading(self, yaw: float, heading: float | None, heading_valid: bool,
                  dt: float) -> tuple[float, bool, str | None]:
@@ -254,7 +275,7 @@ class MotionReferenceUnit:
         for axis, st in zip(self.axes, s["axes"]):
             axis.set_state(st)
         self.yaw_axis.set_state(s["yaw_axis"])
-        self.yaw_ref.set_state(s["yaw_ref"])
+        self.yaw_ref.set_state(s["yaw_ref"], scalar=True)
         self.arm_mean.set_state(s["arm_mean"])
         self.yaw, self.heading_offset = s["yaw"], s["heading_offset"]
         self.rot = np.array(s["rot"], dtype=float)
