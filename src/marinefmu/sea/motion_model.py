@@ -284,6 +284,21 @@ class VesselMotion:
         self._arms_n = np.empty_like(self._body_rows)
         self._acc_minus_g = np.empty(3)
         self._f_imu = np.empty(3)
+        self._op = rigid_point_operator([0.0, 0.0, 0.0], [0.0, 0.0, 0.0])  # identity rows stay
+        self._op_flat = self._op.reshape(-1)
+        self._op_t = self._op.T
+
+    def _point_operator(self, w: list[float], a: list[float]) -> np.ndarray:
+        """:func:`~marinefmu.frames.rigid_point_operator` ``(w, a).T``, its entries written into
+        an array made once (building the (9, 3) array from lists costs more than the product)."""
+        wx, wy, wz = w
+        ax, ay, az = a
+        o = self._op_flat
+        o[10], o[11], o[12], o[14], o[15], o[16] = -wz, wy, wz, -wx, -wy, wx
+        o[18], o[19], o[20] = -wy * wy - wz * wz, wx * wy - az, wx * wz + ay
+        o[21], o[22], o[23] = wx * wy + az, -wx * wx - wz * wz, wy * wz - ax
+        o[24], o[25], o[26] = wx * wz - ay, wy * wz + ax, -wx * wx - wy * wy
+        return self._op_t
 
     def reset(self) -> None:
         """Return to t = 0 with freshly seeded sensor noise."""
@@ -331,7 +346,7 @@ class VesselMotion:
         x = self._x_real.tolist()
         euler = x[3:6]
         rot, rate, ang_acc = attitude_kinematics(euler, x[9:12], x[15:18])
-        np.matmul(self._arms, rigid_point_operator(rate, ang_acc).T, out=self._body)
+        np.matmul(self._arms, self._point_operator(rate, ang_acc), out=self._body)
         np.matmul(self._body_rows, rot.T, out=self._arms_n)
         n = self._arms_n.tolist()  # rows: (offset, velocity, acceleration) of COG, IMU, point
         p0, p1, p2, v0, v1, v2, a0, a1, a2 = x[0], x[1], x[2], x[6], x[7], x[8], x[12], x[13], x[14]
