@@ -29,23 +29,37 @@ R_nb l's change.
 Bad samples (NaN, Inf, |f| > 200 m/s², |roll| or |pitch| > 80°) are replaced in the window by
 the last good sample; ``valid`` is False while more than ``max_bad_fraction`` of the fitted
 window was replaced, on the bad step itself, and until the first window is full.
+
+Cost per step: every step checks the sample in plain floats, stores it in the window buffers
+and reads the window-centre estimate from a block of model values, less the lever arm's band
+part; the block (:data:`TABLE_BLOCK` steps, the exponentials of the fixed model at the
+centre's next sample times, the same arguments :meth:`~DisplacementReconstructor.estimate_at`
+takes) is computed once per block. Only every ``hop`` s: the tilt correction, the decimation,
+the three decompositions (one Hankel SVD each, then the eigenvalues and least squares of the
+candidate orders) and the band-passed lever arm. BLAS runs on one thread for the refit and the
+block. The raw R_nb l is computed only where the extrapolation needs it, from the stored angles.
 """
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...errors import check_choice, check_range, check_vector
 from ...frames import G, rot_nb
-from ..samples import angles_beyond_limit, force_beyond_limit
+from ..numerics import one_blas_thread
+from ..samples import MAX_SPECIFIC_FORCE, MAX_TILT, MAX_YAW, angles_beyond_limit, force_beyond_limit
 from .decomposition import (
     TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, lever_arm_offset,
     lowpass_decimate, tilt_correct,
 )
 
 log = logging.getLogger(__name__)
+
+#: Steps of window-centre model values computed at once (:meth:`DisplacementReconstructor._centre`).
+TABLE_BLOCK = 250
 
 
 @dataclass(frozen=True)
@@ -144,7 +158,6 @@ class DisplacementReconstructor:
         n = self.n_win
         self.acc = np.zeros((n, 3))  # specific force [m/s², b]; tilt-corrected at each refit
         self.euler = np.zeros((n, 3))
-        self.arm = np.zeros((n, 3))
         self.bad = np.zeros(n, dtype=bool)
         self.k = 0  # samples received
         self.last_good: tuple[np.ndarray, np.ndarray] | None = None
@@ -153,6 +166,12 @@ class DisplacementReconstructor:
         self.arm_band = np.zeros((0, 3))  # R_nb l in the screen's band over the fitted window [m, NED]
         self.arm_end = np.zeros(3)  # the raw R_nb l at the fitted window's last sample
         self.fit_bad_fraction = 1.0
+        self._drop_table()
+
+    def _drop_table(self) -> None:
+        """Forget the block of window-centre model values (derived state, rebuilt on demand)."""
+        self._tab_k0 = -1  # the sample count k of the block's first row
+        self._tab = np.zeros((0, 6))
 
     # ---- per step ------------------------------------------------------------------------------
     def step(self, acc, euler, dt: float) -> DisplacementReconstructorResult:
@@ -183,12 +202,11 @@ class DisplacementReconstructor:
         i = self.k % self.n_win
         self.acc[i] = acc
         self.euler[i] = euler
-        arm = rot_nb(*euler) @ self.lever
-        self.arm[i] = arm
         self.bad[i] = warning is not None
         self.k += 1
         if self.k >= self.n_win and (self.k - self.n_win) % self.n_hop == 0:
-            self._refit()
+            with one_blas_thread():
+                self._refit()
         return self._outputs(warning)
 
     def _ordered(self, buf: np.ndarray) -> np.ndarray:
@@ -197,8 +215,8 @@ class DisplacementReconstructor:
 
     def _refit(self) -> None:
         p, dt = self.params, self.dt
-        acc = tilt_correct(self._ordered(self.acc), self._ordered(self.euler), p.tilt)
-        arm = self._ordered(self.arm)
+        euler = self._ordered(self.euler)
+        acc = tilt_correct(self._ordered(self.acc), euler, p.tilt)
         self.t_start = (self.k - self.n_win) * dt
         xd = lowpass_decimate(acc, self.q)
         models = []
@@ -209,9 +227,14 @@ class DisplacementReconstructor:
             lam, gam = d.lam[d.kept], d.gamma[d.kept]
             models.append((lam, gam / lam ** 2, gam / lam))
         self.models = models
-        self.arm_band = lever_arm_offset(self._ordered(self.euler), self.lever, dt, p.cutoff)
-        self.arm_end = arm[-1].copy()
+        self.arm_band = lever_arm_offset(euler, self.lever, dt, p.cutoff)
+        self.arm_end = self._arm(self.k - 1)
         self.fit_bad_fraction = float(self.bad.mean())
+        self._drop_table()
+
+    def _arm(self, k: int) -> np.ndarray:
+        """The raw R_nb l [m, NED] of absolute sample ``k`` (in the window buffer)."""
+        return rot_nb(*self.euler[k % self.n_win]) @ self.lever
 
     def _eval(self, t_rel: float) -> tuple[np.ndarray, np.ndarray]:
         disp, vel = np.zeros(3), np.zeros(3)
@@ -240,17 +263,54 @@ class DisplacementReconstructor:
         t_rel = k * dt - self.t_start  # its time from the start of the fitted window
         disp, vel = self._eval(t_rel)
         i = k - int(round(self.t_start / dt))  # the sample's place in the fitted window
-        arm = self.arm_band[i] if i < len(self.arm_band) else self.arm_band[-1] + self.arm[k % self.n_win] - self.arm_end
+        arm = self.arm_band[i] if i < len(self.arm_band) else self.arm_band[-1] + self._arm(k) - self.arm_end
         return disp - arm, vel
+
+    def _centre(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """:meth:`estimate_at` (``delay``) of the latest sample, from a block of
+        :data:`TABLE_BLOCK` steps of the model's values at the window centre: the model is
+        fixed between refits and the centre advances one sample a step, so the block's
+        exponentials are those :meth:`_eval` would take one step at a time (the same
+        arguments; only the order of the sums over components differs, by rounding)."""
+        j = int(round(0.5 * self.params.window / self.dt))
+        m = self.k - self._tab_k0
+        if not 0 <= m < len(self._tab):
+            self._build_table(j)
+            m = self.k - self._tab_k0
+        k = self.k - 1 - j
+        i = k - int(round(self.t_start / self.dt))
+        row = self._tab[m]
+        if i < len(self.arm_band):
+            a = self.arm_band[i]
+        else:
+            a = self.arm_band[-1] + self._arm(k) - self.arm_end
+        return (float(row[0] - a[0]), float(row[1] - a[1]), float(row[2] - a[2])), (float(row[3]), float(row[4]), float(row[5]))
+
+    def _build_table(self, j: int) -> None:
+        """The block holding the current step, counted from the refit in whole blocks: the
+        same blocks whether the steps ran on or the state was restored in between."""
+        dt, n = self.dt, TABLE_BLOCK
+        k_fit = int(round(self.t_start / dt)) + self.n_win  # the sample count at the refit
+        k0 = k_fit + (self.k - k_fit) // n * n
+        k = np.arange(k0 - 1 - j, k0 - 1 - j + n)  # absolute sample indices of the centre
+        t_rel = k * dt - self.t_start
+        tab = np.zeros((n, 6))
+        with one_blas_thread():
+            for axis, (lam, c2, c1) in enumerate(self.models):
+                if len(lam):
+                    e = np.exp(np.multiply.outer(t_rel, lam))
+                    tab[:, axis] = (e @ c2).real
+                    tab[:, 3 + axis] = (e @ c1).real
+        self._tab, self._tab_k0 = tab, k0
 
     def _outputs(self, warning: str | None) -> DisplacementReconstructorResult:
         delay = 0.5 * self.params.window
-        est = self.estimate_at(delay)
-        if est is None:
+        if self.models is None:
             z = (0.0, 0.0, 0.0)
             return DisplacementReconstructorResult(z, z, delay, False, warning)
+        disp, vel = self._centre()
         valid = warning is None and self.fit_bad_fraction <= self.params.max_bad_fraction
-        return DisplacementReconstructorResult(tuple(est[0]), tuple(est[1]), delay, valid, warning)
+        return DisplacementReconstructorResult(disp, vel, delay, valid, warning)
 
     # ---- FMU state ---------------------------------------------------------------------------
     def get_state(self) -> dict:
@@ -261,7 +321,7 @@ class DisplacementReconstructor:
             [[lam.real.tolist(), lam.imag.tolist()], [c2.real.tolist(), c2.imag.tolist()], [c1.real.tolist(), c1.imag.tolist()]]
             for lam, c2, c1 in self.models]
         return {
-            "dt": self.dt, "acc": self.acc.tolist(), "euler": self.euler.tolist(), "arm": self.arm.tolist(), "bad": self.bad.tolist(), "k": self.k,
+            "dt": self.dt, "acc": self.acc.tolist(), "euler": self.euler.tolist(), "bad": self.bad.tolist(), "k": self.k,
             "last_good": None if self.last_good is None else [self.last_good[0].tolist(), self.last_good[1].tolist()],
             "models": models, "t_start": self.t_start, "arm_band": self.arm_band.tolist(), "arm_end": self.arm_end.tolist(), "fit_bad_fraction": self.fit_bad_fraction,
         }
@@ -273,7 +333,7 @@ class DisplacementReconstructor:
             return
         self.configure(s["dt"])
         self.acc, self.euler = np.array(s["acc"]), np.array(s["euler"])
-        self.arm, self.bad = np.array(s["arm"]), np.array(s["bad"], dtype=bool)
+        self.bad = np.array(s["bad"], dtype=bool)
         self.k = int(s["k"])
         self.last_good = None if s["last_good"] is None else (np.array(s["last_good"][0]), np.array(s["last_good"][1]))
         self.models = None if s["models"] is None else [
@@ -285,8 +345,21 @@ class DisplacementReconstructor:
 
 
 def _check_sample(acc: np.ndarray, euler: np.ndarray) -> str | None:
+    """The rejection reason of a sample, or None. Plain floats for the common good sample;
+    the shared limit checks decide whenever a sample comes near a limit."""
     if acc.shape != (3,) or euler.shape != (3,):
         return "sample of the wrong shape"
-    if not (np.all(np.isfinite(acc)) and np.all(np.isfinite(euler))):
+    a0, a1, a2 = acc.tolist()
+    e0, e1, e2 = euler.tolist()
+    if not (math.isfinite(a0) and math.isfinite(a1) and math.isfinite(a2)
+            and math.isfinite(e0) and math.isfinite(e1) and math.isfinite(e2)):
         return "non-finite acc or attitude sample"
-    return force_beyond_limit(acc) or angles_beyond_limit(euler)
+    if a0 * a0 + a1 * a1 + a2 * a2 > _NEAR_FORCE_SQ or abs(e0) > _NEAR_TILT or abs(e1) > _NEAR_TILT or abs(e2) > _NEAR_YAW:
+        return force_beyond_limit(acc) or angles_beyond_limit(euler)
+    return None
+
+
+# Below these (1 % inside the limits) a sample is good whatever the rounding of the checks.
+_NEAR_FORCE_SQ = (0.99 * MAX_SPECIFIC_FORCE) ** 2
+_NEAR_TILT = 0.99 * MAX_TILT
+_NEAR_YAW = 0.99 * MAX_YAW
