@@ -287,3 +287,79 @@ def test_state_round_trip_reproduces_the_run():
     other = CentreOfRotation()
     other.set_state(saved)
     assert _drive(other, 100, start=400) == first
+
+
+# ---- the per-step float path against the array forms it writes out ----------------------------
+def test_joseph_update_equals_filterpy_update():
+    from filterpy.kalman import KalmanFilter
+    rng = np.random.default_rng(21)
+    kf = KalmanFilter(dim_x=6, dim_z=3)
+    a = rng.normal(size=(6, 6))
+    kf.P, kf.x, kf.R = a @ a.T + np.eye(6), rng.normal(size=(6, 1)), np.eye(3) * 4e-4
+    for _ in range(20):
+        kf.H, z = rng.normal(size=(3, 6)), rng.normal(size=(3, 1))
+        x, P = cr_filter.joseph_update(kf.x, kf.P, kf.H, z, 4e-4)
+        kf.update(z)
+        assert np.array_equal(x, kf.x) and np.array_equal(P, kf.P)
+
+
+def test_step_equals_filterpy_on_the_array_forms():
+    """Each filtered step against a filterpy KalmanFilter fed the same centre sample through
+    frames.rot_nb and measurement_matrix, through a start without rotation (offset held) and
+    then rotating: state and covariance equal, the outputs to 1e-12."""
+    from filterpy.kalman import KalmanFilter
+    from marinefmu.frames import GRAVITY_N
+    dt, n_win = 0.01, window_samples(1.5, 0.01, 4)
+    p = CentreOfRotationParams(angles="input", diff_sizing="fixed", sensor=(5.0, 1.0, -3.0))
+    est, ref = CentreOfRotation(p), KalmanFilter(dim_x=6, dim_z=3)
+    ref.P, ref.R = est.kf.P.copy(), est.kf.R.copy()
+    ref.Q = np.diag([p.acc_rw ** 2 * dt] * 3 + [p.offset_rw ** 2 * dt] * 3)
+    win = CentredWindow(9, n_win, dt, 4)
+    rng = np.random.default_rng(4)
+    held = 0
+    for k in range(5000):
+        t = (k + 1) * dt
+        s = 0.0 if k < 3000 else 1.0                    # no rotation for 30 s: offset held
+        e, ed, edd = _euler(t)
+        e, ed, edd = s * e, s * ed, s * edd
+        rot, w, a = attitude_kinematics(list(e), list(ed), list(edd))
+        acc = rot.T @ (_cr(t)[1] - np.array([0.0, 0.0, G])) - (np.cross(a, OFFSET) + np.cross(w, np.cross(w, OFFSET)))
+        gyro = w + rng.normal(0.0, 1e-4, 3)
+        r = est.step(acc, gyro, dt, e)
+        centre = win.push(np.concatenate((gyro, acc, e)))
+        if centre is None:
+            continue
+        raw, smooth, deriv = centre
+        ref.predict()
+        rot = rot_nb(*raw[6:9])
+        ref.H = cr_filter.measurement_matrix(rot, smooth[0:3], deriv[0:3])
+        if not r.valid:
+            held += 1
+            ref.H[:, 3:6] = 0.0
+            ref.P[0:3, 3:6] = ref.P[3:6, 0:3] = 0.0
+        ref.update(raw[3:6] + rot.T @ GRAVITY_N)
+        assert np.array_equal(est.kf.x, ref.x) and np.array_equal(est.kf.P, ref.P), k
+        assert np.array_equal(est.kf.H, ref.H), k
+        acc_cr = raw[3:6] - ref.H[:, 3:6] @ ref.x[3:6, 0]
+        assert np.allclose(r.acc_cr, acc_cr, rtol=1e-12, atol=1e-12), k
+        assert np.array_equal(r.offset_std, np.sqrt(np.diag(ref.P)[3:6])) and r.euler == tuple(raw[6:9])
+        assert r.ang_acc == tuple(deriv[0:3]) and np.array_equal(r.acc_cr_n, ref.x[0:3, 0])
+    assert 2500 < held < 3000 and r.valid
+
+
+@pytest.mark.parametrize("acc,gyro,euler", [
+    ([0.0, 0.0, -G], [0.0, 0.0, 0.0], None), ([0.0, 0.0, -G], [0.0, 0.0, 0.0], [0.1, -0.2, 3.0]),
+    ([200.0, 0.0, 0.0], [0.0, 0.0, 0.0], None), ([199.99999, 0.0, 0.0], [0.0, 0.0, 0.0], None),
+    ([200.00001, 0.0, 0.0], [0.0, 0.0, 0.0], None), ([0.0, 0.0, -G], [0.0, -10.0, 0.0], None),
+    ([0.0, 0.0, -G], [0.0, 10.000001, 0.0], None), ([1e308, 1e308, 0.0], [0.0, 0.0, 0.0], None),
+    ([math.inf, -math.inf, 0.0], [0.0, 0.0, 0.0], None), ([0.0, 0.0, -G], [math.nan, 0.0, 0.0], None),
+    ([0.0, 0.0, -G], [0.0, 0.0, 0.0], [math.nan, 0.0, 0.0]), ([0.0, 0.0, -G], [0.0, 0.0, 0.0], [0.0, 1.4, 0.0]),
+    ([0.0, 0.0, -G], [0.0, 0.0, 0.0], [0.0, 0.0, 2e4]), ([0.0, 0.0, -G], [0.0, 0.0, 0.0], [math.radians(80.0), 0.0, 1e4]),
+])
+def test_float_sample_check_agrees_with_the_array_check(acc, gyro, euler):
+    """The per-step float test passes only samples the array check passes."""
+    verdict = cr_filter._bad_sample(acc, gyro, euler)
+    if cr_filter._plainly_good(acc, gyro, euler):
+        assert verdict is None
+    else:
+        assert verdict is not None or abs(math.hypot(*acc) - 200.0) < 1e-3 or not math.isfinite(sum(acc))

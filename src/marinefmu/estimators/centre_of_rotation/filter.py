@@ -22,10 +22,11 @@ Two differences, each selectable:
   full cross product with α_b, the derivative of the body rates (exact; equal to the paper's
   form for small angles and no yaw motion).
 
-**Filter** (eqs. 1-5, filterpy ``KalmanFilter``): state s = [a_CR (N, E, D), o (x, y, z)], a
+**Filter** (eqs. 1-5): state s = [a_CR (N, E, D), o (x, y, z)], a
 random walk (F = I, eq. 1) with process-noise densities ``acc_rw`` and ``offset_rw``;
 measurement z = f_b + R_nbᵀ g_n = H s with the time-varying H = [R_nbᵀ, −M(ω, α)],
-M = [α×] + [ω×]² (eq. 11); Joseph-form covariance update (eq. 5, filterpy's default).
+M = [α×] + [ω×]² (eq. 11); Joseph-form covariance update (eq. 5): :func:`joseph_update`, the
+operations of filterpy's ``KalmanFilter.update`` in the same order (a test checks the two agree).
 The offset is identifiable only statistically: the filter finds the point whose acceleration
 is uncorrelated with α. Over a finite record the CR's acceleration and the rotation have a
 non-zero sample correlation, so even with exact data the estimate scatters about the true CR by
@@ -85,8 +86,16 @@ Outputs: the offset and its standard deviation (filter covariance), its running 
 CR relative to the COG for a sensor at ``sensor`` (COG frame), the specific force a sensor at
 the CR would read (acc_cr, body) and the CR's acceleration (NED).
 
-Not from a library: the Savitzky–Golay weights are scipy's; the filter is filterpy's; only the
-measurement matrix and the leaky angle integrator are written here.
+**Cost per step.** Every filtered sample runs the Savitzky–Golay products over the window, the
+rotation and H written out in floats, the prediction P + Q (F = I, so no products) and the
+Joseph-form update (H changes with every sample, so the covariance has no steady state and is
+updated every step); the sample checks, the angle integrator, the running statistics and the
+outputs work on plain floats. The window sizing runs every :data:`SIZING_EVERY` s. Nothing is
+approximated: the float forms are the same expressions as the array forms they stand for.
+
+Not from a library: the Savitzky–Golay weights are scipy's; the update is filterpy's
+``KalmanFilter.update`` in the same operations; only the measurement matrix and the leaky angle
+integrator are written here.
 """
 from __future__ import annotations
 
@@ -99,11 +108,12 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 from ...errors import ParameterTypeError, check_choice, check_range, check_vector
-from ...frames import GRAVITY_N, G, body_to_euler_rates, rigid_point_operator, rot_nb
+from ...frames import GRAVITY_N, G, body_to_euler_rates, rigid_point_operator
 from .centred_window import (CentredWindow, derivative_gain_error, derivative_increment_gain, derivative_noise_gain,
                              window_samples)
 from ..noise_meter import WhiteNoiseMeter
-from ..samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
+from ..samples import (MAX_RATE, MAX_SPECIFIC_FORCE, MAX_TILT, MAX_YAW, angles_beyond_limit, force_beyond_limit,
+                       rate_beyond_limit)
 
 log = logging.getLogger(__name__)
 
@@ -340,6 +350,49 @@ def leaky_angle_step(euler: list[float], rate: list[float], dt: float, cutoff: f
     return [decay * e + gain * d for e, d in zip(euler, body_to_euler_rates(euler, rate))]
 
 
+_EYE6 = np.eye(6)
+
+
+def joseph_update(x: np.ndarray, P: np.ndarray, H: np.ndarray, z: np.ndarray,
+                  r_var: float) -> tuple[np.ndarray, np.ndarray]:
+    r"""Kalman measurement update with the Joseph-form covariance (paper 002, eq. 5) for the
+    measurement noise R = ``r_var`` · I:
+
+    .. math::
+        K = P H^T (H P H^T + R)^{-1},\quad x^+ = x + K (z - H x),\quad
+        P^+ = (I - K H) P (I - K H)^T + K R K^T
+
+    The operations of filterpy's ``KalmanFilter.update`` in the same order and shapes, without
+    its bookkeeping copies (the adds of R's zeros are left out: they change nothing).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        (n, 1) state.
+    P : numpy.ndarray
+        (n, n) covariance (not changed).
+    H : numpy.ndarray
+        (m, n) measurement matrix.
+    z : numpy.ndarray
+        (m, 1) measurement.
+    r_var : float
+        Variance of each measurement.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        New x (n, 1) and P (n, n).
+    """
+    y = z - np.dot(H, x)
+    pht = np.dot(P, H.T)
+    s = np.dot(H, pht)
+    s.flat[::s.shape[0] + 1] += r_var
+    k = np.dot(pht, np.linalg.inv(s))
+    x = x + np.dot(k, y)
+    ikh = (_EYE6 if P.shape[0] == 6 else np.eye(P.shape[0])) - np.dot(k, H)
+    return x, np.dot(np.dot(ikh, P), ikh.T) + np.dot(k * r_var, k.T)
+
+
 # ---- stateful estimator ---------------------------------------------------------------------
 @dataclass(frozen=True)
 class CentreOfRotationResult:
@@ -385,15 +438,38 @@ class CentreOfRotationResult:
     warning: str | None = None
 
 
-def _bad_sample(acc: np.ndarray, gyro: np.ndarray, euler: np.ndarray | None) -> str | None:
+def _bad_sample(acc: Any, gyro: Any, euler: Any) -> str | None:
+    acc, gyro = np.asarray(acc, dtype=float), np.asarray(gyro, dtype=float)
     if not (np.all(np.isfinite(acc)) and np.all(np.isfinite(gyro))):
         return "non-finite acc or gyro sample"
     if euler is not None:
+        euler = np.asarray(euler, dtype=float)
         if not np.all(np.isfinite(euler)):
             return "non-finite roll, pitch or yaw input"
         if reason := angles_beyond_limit(euler):
             return f"{reason} (input)"
     return rate_beyond_limit(gyro) or force_beyond_limit(acc)
+
+
+#: Squared specific force [m²/s⁴] below which :func:`force_beyond_limit` cannot fire, whatever the
+#: rounding of its norm.
+_FORCE_SQ_PLAIN = (MAX_SPECIFIC_FORCE * (1.0 - 1e-9)) ** 2
+
+
+def _plainly_good(acc: list[float], gyro: list[float], euler: list[float] | None) -> bool:
+    """True if :func:`_bad_sample` would pass the sample, by float comparisons only (the per-step
+    test); False sends the sample to :func:`_bad_sample` for the verdict and its reason. A
+    non-finite value makes the sum non-finite; a finite sum that overflows goes to the full check."""
+    a0, a1, a2 = acc
+    g0, g1, g2 = gyro
+    total = a0 + a1 + a2 + g0 + g1 + g2
+    if euler is not None:
+        e0, e1, e2 = euler
+        total += e0 + e1 + e2
+        if max(abs(e0), abs(e1)) > MAX_TILT or abs(e2) > MAX_YAW:
+            return False
+    return (math.isfinite(total) and max(abs(g0), abs(g1), abs(g2)) <= MAX_RATE
+            and a0 * a0 + a1 * a1 + a2 * a2 < _FORCE_SQ_PLAIN)
 
 
 class CentreOfRotation:
@@ -422,9 +498,10 @@ class CentreOfRotation:
         self.dt: float | None = None
         self.window: CentredWindow | None = None
         self.euler = [0.0, 0.0, 0.0]
-        self.last: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None
+        # the last good (acc, gyro, angles or None) as lists of floats
+        self.last: tuple[list[float], list[float], list[float] | None] | None = None
         self.filtered_time = 0.0
-        self.mean_sum = np.zeros(3)
+        self.mean_sum = [0.0, 0.0, 0.0]
         self.mean_count = 0
         # running mean square of |α| [rad²/s⁴], its start-corrected weight, the time it holds [s],
         # and whether the offset is held for want of rotation (module docstring, "No rotation")
@@ -437,17 +514,22 @@ class CentreOfRotation:
         # step-to-step change Δα with their weight, the last α (None after a break); the window
         # [s] in use, the filtered time at the next sizing [s], and centre samples still to skip
         self.gyro_meter = WhiteNoiseMeter(NOISE_TAU)
-        self.ms_alpha = np.zeros(3)
-        self.ms_dalpha = np.zeros(3)
+        self.ms_alpha = [0.0, 0.0, 0.0]
+        self.ms_dalpha = [0.0, 0.0, 0.0]
         self.alpha_stats_weight = 0.0
-        self.prev_alpha: np.ndarray | None = None
+        self.prev_alpha: list[float] | None = None
         self.window_s = p.diff_window
         self.next_sizing = SIZING_EVERY
         self.skip = 0
+        # filterpy's KalmanFilter holds the state s = [a_CR; o] (x, (6, 1)), P, Q (set with the
+        # step, _start), R and H (written in full every filtered step); the update is
+        # joseph_update, the same operations as kf.update; z is a work array
         self.kf = KalmanFilter(dim_x=6, dim_z=3)
         self.kf.P = np.diag([1.0] * 3 + [p.offset_sigma0 ** 2] * 3)
-        self.kf.R = np.eye(3) * p.acc_sigma ** 2
-        self._result = self._output(None, np.zeros(3), [0.0, 0.0, 0.0], False, None)
+        self.r_var = p.acc_sigma ** 2
+        self.kf.R = np.eye(3) * self.r_var
+        self._z = np.zeros((3, 1))
+        self._result = self._output(self.kf.x[:, 0].tolist(), [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], False, None)
 
     def _start(self, dt: float) -> None:
         p = self.params
@@ -480,12 +562,18 @@ class CentreOfRotation:
             by the last good one (hold): ``valid`` is False and ``warning`` says why.
         """
         p = self.params
-        acc = np.asarray(acc, dtype=float)
-        gyro = np.asarray(gyro, dtype=float)
-        ang = np.asarray(euler, dtype=float) if p.angles == "input" else None
-        if p.angles == "input" and (ang is None or ang.shape != (3,)):
-            ang = np.full(3, math.nan)
-        warning = _bad_sample(acc, gyro, ang)
+        a0, a1, a2 = acc
+        g0, g1, g2 = gyro
+        acc = [float(a0), float(a1), float(a2)]
+        gyro = [float(g0), float(g1), float(g2)]
+        ang = None
+        if p.angles == "input":
+            try:
+                e0, e1, e2 = euler
+                ang = [float(e0), float(e1), float(e2)]
+            except (TypeError, ValueError):
+                ang = [math.nan, math.nan, math.nan]
+        warning = None if _plainly_good(acc, gyro, ang) else _bad_sample(acc, gyro, ang)
         if warning is not None:
             log.warning("centre of rotation: %s; holding the last good sample", warning)
             if self.last is None:
@@ -500,15 +588,14 @@ class CentreOfRotation:
         if self.dt is None:
             self._start(dt)
         if ang is None:
-            rate = gyro if prev is None else 0.5 * (gyro + prev[1])
-            self.euler = leaky_angle_step(self.euler, rate.tolist(), dt, p.hp_cutoff)
-            ang = np.array(self.euler)
+            rate = gyro if prev is None else [0.5 * (g + q) for g, q in zip(gyro, prev[1])]
+            self.euler = ang = leaky_angle_step(self.euler, rate, dt, p.hp_cutoff)
         if p.diff_sizing == "auto":
             if warning is None:
-                self.gyro_meter.push(gyro, dt)
+                self.gyro_meter.push(np.array(gyro), dt)
             else:
                 self.gyro_meter.break_chain()
-        centre = self.window.push(np.concatenate((gyro, acc, ang)))
+        centre = self.window.push(gyro + acc + ang)
         if centre is None:
             return self._invalid(warning)
         if self.skip > 0:
@@ -516,40 +603,73 @@ class CentreOfRotation:
             self.skip -= 1
             return self._invalid(warning)
         raw, smooth, deriv = centre
-        omega, alpha, f_b, angles = smooth[0:3], deriv[0:3], raw[3:6], raw[6:9].tolist()
+        raw = raw.tolist()
+        wx, wy, wz = smooth[0:3].tolist() if p.centripetal else (0.0, 0.0, 0.0)
+        alpha = deriv[0:3].tolist()
+        f_b, angles = raw[3:6], raw[6:9]
         observable = self._excitation(alpha, dt)
         if p.diff_sizing == "auto":
             self._alpha_statistics(alpha if warning is None else None, dt)
-        rot = rot_nb(*angles)
-        kf = self.kf
-        kf.predict()
-        # set H rather than pass it: filterpy's update() reshapes z to a column only when H is None
-        kf.H = measurement_matrix(rot, omega, alpha, p.centripetal)
-        if not observable:
+        # R_nb (frames.rot_nb) and H = [R_nbᵀ, −M] (measurement_matrix), written out in floats
+        cf, sf = math.cos(angles[0]), math.sin(angles[0])
+        ct, st = math.cos(angles[1]), math.sin(angles[1])
+        cp, sp = math.cos(angles[2]), math.sin(angles[2])
+        ax, ay, az = alpha
+        if observable:
+            m = ((-wy * wy - wz * wz, wx * wy - az, wx * wz + ay),
+                 (wx * wy + az, -wx * wx - wz * wz, wy * wz - ax),
+                 (wx * wz - ay, wy * wz + ax, -wx * wx - wy * wy))
+        else:
             # no rotation: the offset is held (module docstring, "No rotation"); without its
             # covariance with a_CR the a_CR innovations do not move it either
-            kf.H[:, 3:6] = 0.0
-            kf.P[0:3, 3:6] = kf.P[3:6, 0:3] = 0.0
-        kf.update(f_b + rot.T @ GRAVITY_N)
+            m = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        m0, m1, m2 = m
+        r20, r21, r22 = -st, ct * sf, ct * cf
+        kf = self.kf
+        H = kf.H
+        H[:] = ((cp * ct, sp * ct, r20, -m0[0], -m0[1], -m0[2]),
+                (cp * st * sf - sp * cf, sp * st * sf + cp * cf, r21, -m1[0], -m1[1], -m1[2]),
+                (cp * st * cf + sp * sf, sp * st * cf - cp * sf, r22, -m2[0], -m2[1], -m2[2]))
+        # z = f_b + R_nbᵀ g_n: g_n = (0, 0, g) picks R_nb's last row
+        z = self._z
+        z[:, 0] = (f_b[0] + r20 * G, f_b[1] + r21 * G, f_b[2] + r22 * G)
+        P = kf.P
+        P += kf.Q                                             # predict: F = I (eq. 1)
+        if not observable:
+            P[0:3, 3:6] = P[3:6, 0:3] = 0.0
+        kf.x, kf.P = joseph_update(kf.x, P, H, z, self.r_var)
         self.filtered_time += dt
+        s = kf.x[:, 0].tolist()
         if self.filtered_time >= p.settle_time - 1e-9:
-            self.mean_sum += kf.x[3:6, 0]
+            ms = self.mean_sum
+            ms[0] += s[3]
+            ms[1] += s[4]
+            ms[2] += s[5]
             self.mean_count += 1
-        self._result = self._output(f_b, alpha, angles, warning is None and observable, warning)
+        # what a sensor at the CR would read: f_b + M o
+        o0, o1, o2 = s[3:6]
+        acc_cr = [f_b[0] + (m0[0] * o0 + m0[1] * o1 + m0[2] * o2),
+                  f_b[1] + (m1[0] * o0 + m1[1] * o1 + m1[2] * o2),
+                  f_b[2] + (m2[0] * o0 + m2[1] * o1 + m2[2] * o2)]
+        self._result = self._output(s, acc_cr, alpha, angles, warning is None and observable, warning)
         if p.diff_sizing == "auto" and self.filtered_time >= self.next_sizing - 1e-9:
             self.next_sizing += SIZING_EVERY
             self._size_window(dt)
         return self._result
 
-    def _alpha_statistics(self, alpha: np.ndarray | None, dt: float) -> None:
+    def _alpha_statistics(self, alpha: list[float] | None, dt: float) -> None:
         """Running mean squares per axis of α and of its change since the last filtered sample
         [(rad/s²)²], start-corrected weight; a held sample (None) breaks the chain."""
         prev, self.prev_alpha = self.prev_alpha, alpha
         if alpha is None or prev is None:
             return
         beta = dt / NOISE_TAU
-        self.ms_alpha += beta * (alpha * alpha - self.ms_alpha)
-        self.ms_dalpha += beta * ((alpha - prev) ** 2 - self.ms_dalpha)
+        ms, md = self.ms_alpha, self.ms_dalpha
+        for i in range(3):
+            a = alpha[i]
+            d = a - prev[i]
+            ms[i] += beta * (a * a - ms[i])
+            md[i] += beta * (d * d - md[i])
         self.alpha_stats_weight += beta * (1.0 - self.alpha_stats_weight)
 
     def _size_window(self, dt: float) -> None:
@@ -559,8 +679,8 @@ class CentreOfRotation:
             return
         sigma2 = self.gyro_meter.variance                             # gyro white noise per sample [(rad/s)²]
         n_now = self.window.n
-        var_a = self.ms_alpha / self.alpha_stats_weight - sigma2 * derivative_noise_gain(n_now, dt, POLYORDER)
-        var_da = self.ms_dalpha / self.alpha_stats_weight - sigma2 * derivative_increment_gain(n_now, dt, POLYORDER)
+        var_a = np.array(self.ms_alpha) / self.alpha_stats_weight - sigma2 * derivative_noise_gain(n_now, dt, POLYORDER)
+        var_da = np.array(self.ms_dalpha) / self.alpha_stats_weight - sigma2 * derivative_increment_gain(n_now, dt, POLYORDER)
         if not (np.all(np.isfinite(var_da)) and var_a.sum() > 0.0 and var_da.sum() > 0.0):
             return
         omega_j = math.sqrt(var_da.sum() / var_a.sum()) / dt          # σ(α̇)/σ(α) [rad/s]
@@ -583,11 +703,11 @@ class CentreOfRotation:
         self.prev_alpha = None
         self.window.resize(n_new)
 
-    def _excitation(self, alpha: np.ndarray, dt: float) -> bool:
+    def _excitation(self, alpha: list[float], dt: float) -> bool:
         """Update the running mean square of |α| [rad/s²] and say whether the rotation is enough
         to observe the offset (:data:`MIN_ANG_ACC`); log when it stops being enough."""
         beta = dt / EXCITATION_TAU
-        self.alpha_ms += beta * (float(alpha @ alpha) - self.alpha_ms)
+        self.alpha_ms += beta * (alpha[0] * alpha[0] + alpha[1] * alpha[1] + alpha[2] * alpha[2] - self.alpha_ms)
         self.alpha_weight += beta * (1.0 - self.alpha_weight)
         self.alpha_time += dt
         if self.alpha_time < EXCITATION_MIN - 1e-9:
@@ -611,57 +731,58 @@ class CentreOfRotation:
         """Lag of the estimate behind the newest sample [s] (half the differentiation window)."""
         return self.window.delay if self.window is not None else 0.0
 
-    def _output(self, f_b: np.ndarray | None, alpha: np.ndarray, angles: list[float], valid: bool,
+    def _output(self, s: list[float], acc_cr: list[float], alpha: list[float], angles: list[float], valid: bool,
                 warning: str | None) -> CentreOfRotationResult:
-        x = self.kf.x[:, 0]
-        offset = x[3:6]
-        std = np.sqrt(np.diag(self.kf.P)[3:6])
-        mean = self.mean_sum / self.mean_count if self.mean_count else offset
-        # what a sensor at the CR would read: f_b + M o, with −M the offset block of this step's H
-        acc_cr = np.zeros(3) if f_b is None else f_b - self.kf.H[:, 3:6] @ offset
-        t = lambda v: tuple(float(a) for a in v)  # noqa: E731
+        """The result from the state ``s`` (6 floats) and this step's signals."""
+        offset = tuple(s[3:6])
+        P = self.kf.P
+        std = (math.sqrt(P[3, 3]), math.sqrt(P[4, 4]), math.sqrt(P[5, 5]))
+        n = self.mean_count
+        mean = tuple(v / n for v in self.mean_sum) if n else offset
+        sensor = self.params.sensor
         return CentreOfRotationResult(
-            t(offset), t(std), t(mean), t(np.asarray(self.params.sensor) + mean), t(acc_cr), t(x[0:3]), t(angles),
-            t(alpha), self.delay, valid, self.mean_count > 0, warning,
+            offset, std, mean, (sensor[0] + mean[0], sensor[1] + mean[1], sensor[2] + mean[2]), tuple(acc_cr),
+            tuple(s[0:3]), tuple(angles), tuple(alpha), self.delay, valid, n > 0, warning,
         )
 
     # ---- FMU state ---------------------------------------------------------------------------
     def get_state(self) -> dict:
         """JSON-serialisable internal state."""
-        last = None if self.last is None else [None if v is None else v.tolist() for v in self.last]
+        last = None if self.last is None else [None if v is None else list(v) for v in self.last]
         return {
             "dt": self.dt, "window": None if self.window is None else self.window.get_state(),
             "euler": list(self.euler), "last": last, "filtered_time": self.filtered_time,
-            "mean_sum": self.mean_sum.tolist(), "mean_count": self.mean_count,
+            "mean_sum": list(self.mean_sum), "mean_count": self.mean_count,
             "kf_x": self.kf.x.tolist(), "kf_P": self.kf.P.tolist(),
             "alpha_ms": self.alpha_ms, "alpha_weight": self.alpha_weight, "alpha_time": self.alpha_time,
             "unobservable": self.unobservable,
-            "gyro_meter": self.gyro_meter.get_state(), "ms_alpha": self.ms_alpha.tolist(), "ms_dalpha": self.ms_dalpha.tolist(),
+            "gyro_meter": self.gyro_meter.get_state(), "ms_alpha": list(self.ms_alpha), "ms_dalpha": list(self.ms_dalpha),
             "alpha_stats_weight": self.alpha_stats_weight,
-            "prev_alpha": None if self.prev_alpha is None else self.prev_alpha.tolist(),
+            "prev_alpha": None if self.prev_alpha is None else list(self.prev_alpha),
             "window_s": self.window_s, "next_sizing": self.next_sizing, "skip": self.skip,
         }
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
+        floats = lambda v: [float(a) for a in v]  # noqa: E731
         self.reset()
         self.window_s = float(s["window_s"])
         if s["dt"] is not None:
             self._start(float(s["dt"]))
             self.window.set_state(s["window"])
-        self.euler = [float(v) for v in s["euler"]]
-        self.last = None if s["last"] is None else tuple(None if v is None else np.array(v) for v in s["last"])
+        self.euler = floats(s["euler"])
+        self.last = None if s["last"] is None else tuple(None if v is None else floats(v) for v in s["last"])
         self.filtered_time = float(s["filtered_time"])
-        self.mean_sum, self.mean_count = np.array(s["mean_sum"]), int(s["mean_count"])
-        self.kf.x, self.kf.P = np.array(s["kf_x"]), np.array(s["kf_P"])
+        self.mean_sum, self.mean_count = floats(s["mean_sum"]), int(s["mean_count"])
+        self.kf.x = np.array(s["kf_x"], dtype=float).reshape(6, 1)
+        self.kf.P = np.array(s["kf_P"], dtype=float).reshape(6, 6)
         self.alpha_ms, self.alpha_weight = float(s["alpha_ms"]), float(s["alpha_weight"])
         self.alpha_time, self.unobservable = float(s["alpha_time"]), bool(s["unobservable"])
         self.gyro_meter.set_state(s["gyro_meter"])
-        self.ms_alpha, self.ms_dalpha = np.array(s["ms_alpha"]), np.array(s["ms_dalpha"])
+        self.ms_alpha, self.ms_dalpha = floats(s["ms_alpha"]), floats(s["ms_dalpha"])
         self.alpha_stats_weight = float(s["alpha_stats_weight"])
-        self.prev_alpha = None if s["prev_alpha"] is None else np.array(s["prev_alpha"])
+        self.prev_alpha = None if s["prev_alpha"] is None else floats(s["prev_alpha"])
         self.next_sizing, self.skip = float(s["next_sizing"]), int(s["skip"])
-
 
 def estimate_centre_of_rotation(acc: np.ndarray, gyro: np.ndarray, dt: float,
                                 params: CentreOfRotationParams | None = None,
