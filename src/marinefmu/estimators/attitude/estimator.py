@@ -20,7 +20,8 @@ instability (a 5e-5 rad/s Gauss–Markov bias with τ = 50 s leaves ≈ 0.4° of
 We use instead the marine-VRU construction (aided strapdown, as in the VRU of smsfusion):
 the tilt-corrected acceleration a_n = R̂ f_b + g_n is integrated to a horizontal velocity and
 position, and zero-mean pseudo-measurements "horizontal velocity = 0 ± σ_v, position = 0 ± σ_p"
-at ``aid_rate`` feed an error-state Kalman filter (filterpy ``KalmanFilter``) with states
+at ``aid_rate`` feed an error-state Kalman filter (filterpy ``KalmanFilter``'s predict and Joseph-form
+update, written out for this filter's F and H: :func:`aid_update`) with states
 
 .. math::
     δx = [δp_N, δp_E, δv_N, δv_E, ε_N, ε_E, δb_x, δb_y],\\qquad
@@ -91,12 +92,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from filterpy.kalman import KalmanFilter
 
 from ...errors import check_choice, check_int, check_range, check_vector
-from ...frames import euler_to_quat, level_angles, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot
+from ...frames import euler_to_quat, level_angles, quat_mul, quat_to_euler
 from ..noise_meter import WhiteNoiseMeter
-from ..samples import force_beyond_limit, rate_beyond_limit
+from ..samples import MAX_RATE, MAX_SPECIFIC_FORCE, force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
 
@@ -218,6 +218,27 @@ class AttitudeResult:
     warning: str | None = None
 
 
+def _quat_step(qw: float, qx: float, qy: float, qz: float, vx: float, vy: float, vz: float) -> tuple[float, float, float, float]:
+    """q ⊗ exp(½ v) for the rotation vector v [rad], normalised, on Python floats: the kernel of
+    :func:`integrate_gyro` (:func:`~marinefmu.frames.quat_from_rotvec` and
+    :func:`~marinefmu.frames.quat_mul` written out, term for term)."""
+    a2 = vx * vx + vy * vy + vz * vz
+    if a2 < 1e-8:
+        s = 0.5 - a2 / 48.0
+        c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0
+    else:
+        a = math.sqrt(a2)
+        s = math.sin(0.5 * a) / a
+        c = math.cos(0.5 * a)
+    rx, ry, rz = s * vx, s * vy, s * vz
+    w = qw * c - qx * rx - qy * ry - qz * rz
+    x = qw * rx + qx * c + qy * rz - qz * ry
+    y = qw * ry - qx * rz + qy * c + qz * rx
+    z = qw * rz + qx * ry - qy * rx + qz * c
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    return w / n, x / n, y / n, z / n
+
+
 def integrate_gyro(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
     """One exact strapdown step of eq. 6: q ⊗ exp(½ ω Δt), normalised.
 
@@ -235,8 +256,9 @@ def integrate_gyro(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
     numpy.ndarray
         (4,) unit quaternion at the end of the step.
     """
-    qn = quat_mul(q, quat_from_rotvec(np.asarray(omega) * dt))
-    return qn / math.sqrt(qn @ qn)
+    qw, qx, qy, qz = (float(v) for v in q)
+    wx, wy, wz = (float(v) for v in omega)
+    return np.array(_quat_step(qw, qx, qy, qz, wx * dt, wy * dt, wz * dt))
 
 
 def integrate_gyro_euler(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndarray:
@@ -248,14 +270,67 @@ def integrate_gyro_euler(q: np.ndarray, omega: np.ndarray, dt: float) -> np.ndar
     return qn / math.sqrt(qn @ qn)
 
 
+def aid_update(P: np.ndarray, R: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The Kalman update of the error state for the pseudo-measurement z = [p_N, p_E, v_N, v_E]
+    of H = [I₄ 0] with a zero prior error state (filterpy ``KalmanFilter.update``, Joseph form,
+    with its products by H written as slices: P Hᵀ = P[:, :4], H P Hᵀ = P[:4, :4]).
+
+    Parameters
+    ----------
+    P : numpy.ndarray
+        (8, 8) prior covariance.
+    R : numpy.ndarray
+        (4, 4) measurement covariance [m², m²/s²].
+    z : numpy.ndarray
+        (4, 1) the integrated position [m, n] and velocity [m/s, n], which the aid says are 0.
+
+    Returns
+    -------
+    dx : numpy.ndarray
+        (8, 1) posterior error state (K z).
+    P : numpy.ndarray
+        (8, 8) posterior covariance (I − KH) P (I − KH)ᵀ + K R Kᵀ.
+    """
+    pht = P[:, :4]
+    k = np.dot(pht, np.linalg.inv(pht[:4] + R))
+    i_kh = np.eye(8)
+    i_kh[:, :4] -= k
+    return np.dot(k, z), np.dot(np.dot(i_kh, P), i_kh.T) + np.dot(np.dot(k, R), k.T)
+
+
 def _bad_sample(gyro: np.ndarray, acc: np.ndarray) -> str | None:
     if not (np.all(np.isfinite(gyro)) and np.all(np.isfinite(acc))):
         return "non-finite gyro or acc sample"
     return rate_beyond_limit(gyro) or force_beyond_limit(acc)
 
 
+#: Squared specific force [m²/s⁴] below which a finite sample passes without the full check
+#: (a margin inside :data:`~marinefmu.estimators.samples.MAX_SPECIFIC_FORCE`).
+_FORCE_PASS2 = (0.99 * MAX_SPECIFIC_FORCE) ** 2
+
+
+class ErrorStateFilter:
+    """The arrays of the error-state Kalman filter: ``x`` (8, 1), zero between steps (each
+    update is injected into the nominal state and reset), ``P`` (8, 8) and ``R`` (4, 4)."""
+
+    __slots__ = ("x", "P", "R")
+
+    def __init__(self, P: np.ndarray, R: np.ndarray) -> None:
+        self.x = np.zeros((8, 1))
+        self.P = P
+        self.R = R
+
+
 class AttitudeEstimator:
     """Attitude (roll, pitch, yaw, quaternion) from gyro and accelerometer samples.
+
+    Cost per step: every step, the quaternion step and the rotation of the specific force on
+    Python floats, the horizontal velocity and position, and the covariance prediction
+    P ← F P Fᵀ + Q Δt on preallocated (8, 8) arrays (F = I + A Δt changes with R̂ and f_n
+    every step, so it has no steady state); F's constant entries and Q Δt are rebuilt only
+    when Δt or the gyro's sized noise changes. The error state's prediction is skipped: it is
+    zero between updates (F·0 = 0). The gain, the update and the injection run at
+    ``aid_rate``. While levelling only the gyro integration and the rotated force sum run.
 
     Parameters
     ----------
@@ -272,32 +347,42 @@ class AttitudeEstimator:
 
     def __init__(self, params: AttitudeEstimatorParams | None = None) -> None:
         self.params = params or AttitudeEstimatorParams()
+        p = self.params
+        self._mode1 = p.mode == 1
+        self._auto = p.aid_sizing == "auto"
+        self._aid_period = 1.0 / p.aid_rate - 1e-9
+        self._bias_decay = -1.0 / p.gyro_bias_tau
+        self._F = np.eye(8)
+        self._FT = self._F.T
+        self._FP = np.empty((8, 8))
+        self._z = np.empty((4, 1))
         self.reset()
 
     def reset(self) -> None:
         """Back to the initial state."""
         p = self.params
-        self.q = euler_to_quat(*p.init_euler)
-        self.bias = np.zeros(3)
-        self.vel = np.zeros(2)
-        self.last_gyro: np.ndarray | None = None
-        self.last_acc: np.ndarray | None = None
+        self._q = tuple(euler_to_quat(*p.init_euler).tolist())
+        self._bias = [0.0, 0.0, 0.0]
+        self._vel = [0.0, 0.0]
+        self._pos = [0.0, 0.0]
+        self._last_gyro: tuple[float, float, float] | None = None
+        self._last_acc: tuple[float, float, float] | None = None
         self.levelling = p.init == "level"
         self.level_steps = 0
-        self.level_sum = np.zeros(3)
-        self.q_rel = np.array([1.0, 0.0, 0.0, 0.0])
+        self._level_sum = [0.0, 0.0, 0.0]
+        self._q_rel = (1.0, 0.0, 0.0, 0.0)
         self.since_aid = 0.0
-        self.pos = np.zeros(2)
-        self.kf = KalmanFilter(dim_x=8, dim_z=4)
-        self.kf.P = np.diag([p.pos_sigma ** 2] * 2 + [p.vel_sigma ** 2] * 2 + [math.radians(2.0) ** 2] * 2
-                            + [p.gyro_bias_sigma ** 2] * 2)
-        self.kf.H = np.hstack((np.eye(4), np.zeros((4, 4))))
-        self.kf.R = np.diag([p.pos_sigma ** 2] * 2 + [p.vel_sigma ** 2] * 2)
+        self.kf = ErrorStateFilter(
+            np.diag([p.pos_sigma ** 2] * 2 + [p.vel_sigma ** 2] * 2 + [math.radians(2.0) ** 2] * 2
+                    + [p.gyro_bias_sigma ** 2] * 2),
+            np.diag([p.pos_sigma ** 2] * 2 + [p.vel_sigma ** 2] * 2))
         self._q_diag = np.diag([0.0, 0.0] + [p.acc_noise ** 2] * 2 + [0.0] * 4)  # gyro entries below
+        self._dt: float | None = None  # the Δt that F's constant entries and Q Δt were built for
+        self._q_dt = np.zeros((8, 8))
         # auto sizing: the leaky integrator and its running statistics
-        self.acc_mean: np.ndarray | None = None
-        self.leak_v = np.zeros(2)
-        self.ms_v = np.zeros(2)
+        self._acc_mean: list[float] | None = None
+        self._leak_v = [0.0, 0.0]
+        self._ms_v = [0.0, 0.0]
         self.stats_weight = 0.0
         self.stats_time = 0.0
         # auto sizing of the gyro noise: the running mean of its second difference
@@ -305,6 +390,27 @@ class AttitudeEstimator:
         self.gyro_noise_used = p.gyro_noise
         self.gyro_bias_sigma_used = p.gyro_bias_sigma
         self._set_gyro_process_noise()
+
+    # ---- read-only views of the state as arrays ------------------------------------------------
+    @property
+    def q(self) -> np.ndarray:
+        """(4,) unit quaternion (w, x, y, z) of R_nb."""
+        return np.array(self._q)
+
+    @property
+    def bias(self) -> np.ndarray:
+        """(3,) estimated gyro bias [rad/s, b]."""
+        return np.array(self._bias)
+
+    @property
+    def vel(self) -> np.ndarray:
+        """(2,) integrated horizontal velocity [m/s, n] (north, east)."""
+        return np.array(self._vel)
+
+    @property
+    def pos(self) -> np.ndarray:
+        """(2,) integrated horizontal position [m, n] (north, east)."""
+        return np.array(self._pos)
 
     # ---- step ---------------------------------------------------------------------------------
     def step(self, gyro: Any, acc: Any, dt: float) -> AttitudeResult:
@@ -325,86 +431,146 @@ class AttitudeEstimator:
             A non-finite or absurd sample is rejected: the last good sample is used instead
             (coasting), ``valid`` is False and ``warning`` says why.
         """
-        gyro = np.asarray(gyro, dtype=float)
-        acc = np.asarray(acc, dtype=float)
-        warning = _bad_sample(gyro, acc)
+        gx, gy, gz = gyro
+        ax, ay, az = acc
+        gx, gy, gz, ax, ay, az = float(gx), float(gy), float(gz), float(ax), float(ay), float(az)
+        # NaN fails every comparison, so a non-finite sample takes the full check too
+        if (-MAX_RATE <= gx <= MAX_RATE and -MAX_RATE <= gy <= MAX_RATE and -MAX_RATE <= gz <= MAX_RATE
+                and ax * ax + ay * ay + az * az <= _FORCE_PASS2):
+            warning = None
+        else:
+            warning = _bad_sample(np.array((gx, gy, gz)), np.array((ax, ay, az)))
         if warning is not None:
             log.warning("attitude: %s; coasting on the last good sample", warning)
-            if self.last_gyro is None:
+            if self._last_gyro is None:
                 return self._result(False, warning)
-            gyro, acc = self.last_gyro, self.last_acc
+            (gx, gy, gz), (ax, ay, az) = self._last_gyro, self._last_acc
             self.gyro_meter.break_chain()  # a second difference spans consecutive good samples only
-        elif self.params.aid_sizing == "auto":
-            self.gyro_meter.push(gyro, dt)
-        w_prev = gyro if self.last_gyro is None else self.last_gyro
-        omega = 0.5 * (w_prev + gyro) - self.bias
-        self.last_gyro, self.last_acc = gyro, acc
+        elif self._auto:
+            self.gyro_meter.push(np.array((gx, gy, gz)), dt)
+        last = self._last_gyro
+        px, py, pz = (gx, gy, gz) if last is None else last
+        bx, by, bz = self._bias
+        wx, wy, wz = 0.5 * (px + gx) - bx, 0.5 * (py + gy) - by, 0.5 * (pz + gz) - bz
+        self._last_gyro, self._last_acc = (gx, gy, gz), (ax, ay, az)
         if self.levelling:
-            self._level(omega, acc, dt)
+            self._level(wx, wy, wz, ax, ay, az, dt)
             return self._result(False, warning)
-        self.q = integrate_gyro(self.q, omega, dt)
-        if self.params.mode == 1:
-            self._aid(acc, dt)
+        qw, qx, qy, qz = self._q
+        self._q = _quat_step(qw, qx, qy, qz, wx * dt, wy * dt, wz * dt)
+        if self._mode1:
+            self._aid(ax, ay, az, dt)
         return self._result(warning is None, warning)
 
-    def _level(self, omega: np.ndarray, acc: np.ndarray, dt: float) -> None:
+    def _level(self, wx: float, wy: float, wz: float, ax: float, ay: float, az: float, dt: float) -> None:
         """Accumulate the specific force in the frame of the first sample (gyro-derotated)."""
         if self.level_steps > 0:
-            self.q_rel = integrate_gyro(self.q_rel, omega, dt)
-        self.level_sum += quat_to_rot(self.q_rel) @ acc
+            qw, qx, qy, qz = self._q_rel
+            self._q_rel = _quat_step(qw, qx, qy, qz, wx * dt, wy * dt, wz * dt)
+        w, x, y, z = self._q_rel
+        s = self._level_sum
+        s[0] += (w * w + x * x - y * y - z * z) * ax + 2.0 * (x * y - w * z) * ay + 2.0 * (x * z + w * y) * az
+        s[1] += 2.0 * (x * y + w * z) * ax + (w * w - x * x + y * y - z * z) * ay + 2.0 * (y * z - w * x) * az
+        s[2] += 2.0 * (x * z - w * y) * ax + 2.0 * (y * z + w * x) * ay + (w * w - x * x - y * y + z * z) * az
         self.level_steps += 1
         if self.level_steps * dt >= self.params.level_time - 1e-9:
-            roll, pitch = level_angles(self.level_sum / self.level_steps)
+            n = self.level_steps
+            roll, pitch = level_angles((s[0] / n, s[1] / n, s[2] / n))
             q0 = euler_to_quat(roll, pitch, self.params.init_euler[2])
-            self.q = quat_mul(q0, self.q_rel)
+            self._q = tuple(quat_mul(q0, self._q_rel).tolist())
             self.levelling = False
 
-    def _aid(self, acc: np.ndarray, dt: float) -> None:
-        """Velocity- and position-aided tilt and gyro-bias correction (module docstring)."""
-        p = self.params
-        rot = quat_to_rot(self.q)
-        f_n = rot @ acc
-        self.pos += self.vel * dt + 0.5 * f_n[:2] * dt * dt  # horizontal a_n = R f_b + g_n has no g
-        self.vel += f_n[:2] * dt
-        if p.aid_sizing == "auto":
-            self._wave_statistics(f_n[:2], dt)
-        fz = f_n[2]
-        F = np.zeros((8, 8))
-        F[0:2, 2:4] = np.eye(2)
-        F[2:4, 4:6] = [[0.0, -fz], [fz, 0.0]]  # f_n × ε for ε = [ε_N, ε_E, 0]
-        F[4:6, 6:8] = -rot[0:2, 0:2]
-        F[6:8, 6:8] = -np.eye(2) / p.gyro_bias_tau
-        kf = self.kf
-        kf.F = np.eye(8) + F * dt
-        kf.Q = self._q_diag * dt
-        kf.predict()
-        self.since_aid += dt
-        if self.since_aid >= 1.0 / p.aid_rate - 1e-9:
-            self.since_aid = 0.0
-            if p.aid_sizing == "auto" and self.stats_time >= LEAK_TAU:
-                sigma_v = np.maximum(SIGMA_V_MIN, AID_GAIN * np.sqrt(self.ms_v / self.stats_weight))
-                kf.R = np.diag(np.concatenate(((POS_RATIO * sigma_v) ** 2, sigma_v ** 2)))
-            if p.aid_sizing == "auto" and self.gyro_meter.time >= NOISE_SETTLE:
-                self._size_gyro_noise(dt)
-            kf.update(np.concatenate((self.pos, self.vel)))
-            dx = kf.x.ravel()
-            self.pos -= dx[0:2]
-            self.vel -= dx[2:4]
-            self.q = quat_mul(quat_from_rotvec(np.array([dx[4], dx[5], 0.0])), self.q)
-            self.q /= math.sqrt(self.q @ self.q)
-            self.bias[0:2] += dx[6:8]
-            kf.x[:] = 0.0
+    def _set_step(self, dt: float) -> None:
+        """F's entries that depend on Δt only, and Q Δt."""
+        F = self._F
+        F[0, 2] = F[1, 3] = dt
+        F[6, 6] = F[7, 7] = 1.0 + self._bias_decay * dt
+        self._dt = dt
+        np.multiply(self._q_diag, dt, out=self._q_dt)
 
-    def _wave_statistics(self, a_h: np.ndarray, dt: float) -> None:
+    def _aid(self, ax: float, ay: float, az: float, dt: float) -> None:
+        """Velocity- and position-aided tilt and gyro-bias correction (module docstring)."""
+        w, x, y, z = self._q
+        ww, xx, yy, zz = w * w, x * x, y * y, z * z
+        r00, r01, r02 = ww + xx - yy - zz, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
+        r10, r11, r12 = 2.0 * (x * y + w * z), ww - xx + yy - zz, 2.0 * (y * z - w * x)
+        fn = r00 * ax + r01 * ay + r02 * az
+        fe = r10 * ax + r11 * ay + r12 * az
+        fz = 2.0 * (x * z - w * y) * ax + 2.0 * (y * z + w * x) * ay + (ww - xx - yy + zz) * az
+        pos, vel = self._pos, self._vel
+        vn, ve = vel
+        pos[0] += vn * dt + 0.5 * fn * dt * dt  # horizontal a_n = R f_b + g_n has no g
+        pos[1] += ve * dt + 0.5 * fe * dt * dt
+        vel[0] = vn + fn * dt
+        vel[1] = ve + fe * dt
+        if self._auto:
+            self._wave_statistics(fn, fe, dt)
+        if dt != self._dt:
+            self._set_step(dt)
+        # F = I + A Δt: δṗ = δv, δv̇ = f_n × ε for ε = [ε_N, ε_E, 0], ε̇ = −R̂ δb, δḃ = −δb/τ_b
+        F = self._F
+        F[2, 5] = -fz * dt
+        F[3, 4] = fz * dt
+        F[4, 6] = -r00 * dt
+        F[4, 7] = -r01 * dt
+        F[5, 6] = -r10 * dt
+        F[5, 7] = -r11 * dt
+        kf = self.kf
+        P = kf.P
+        np.dot(F, P, out=self._FP)
+        np.dot(self._FP, self._FT, out=P)
+        P += self._q_dt
+        self.since_aid += dt
+        if self.since_aid >= self._aid_period:
+            self.since_aid = 0.0
+            if self._auto and self.stats_time >= LEAK_TAU:
+                R = kf.R
+                for i in range(2):
+                    sigma_v = max(SIGMA_V_MIN, AID_GAIN * math.sqrt(self._ms_v[i] / self.stats_weight))
+                    sigma_p = POS_RATIO * sigma_v
+                    R[i, i] = sigma_p * sigma_p
+                    R[2 + i, 2 + i] = sigma_v * sigma_v
+            if self._auto and self.gyro_meter.time >= NOISE_SETTLE:
+                self._size_gyro_noise(dt)
+            zv = self._z
+            zv[0, 0], zv[1, 0], zv[2, 0], zv[3, 0] = pos[0], pos[1], vel[0], vel[1]
+            dx, kf.P = aid_update(P, kf.R, zv)
+            d = dx[:, 0].tolist()
+            pos[0] -= d[0]
+            pos[1] -= d[1]
+            vel[0] -= d[2]
+            vel[1] -= d[3]
+            # q ← exp([ε×]) q̂ for ε = [δε_N, δε_E, 0]
+            ex, ey = d[4], d[5]
+            a2 = ex * ex + ey * ey
+            if a2 < 1e-8:
+                s = 0.5 - a2 / 48.0
+                c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0
+            else:
+                a = math.sqrt(a2)
+                s = math.sin(0.5 * a) / a
+                c = math.cos(0.5 * a)
+            rx, ry = s * ex, s * ey
+            w, x, y, z = self._q
+            w, x, y, z = c * w - rx * x - ry * y, c * x + rx * w + ry * z, c * y - rx * z + ry * w, c * z + rx * y - ry * x
+            n = math.sqrt(w * w + x * x + y * y + z * z)
+            self._q = (w / n, x / n, y / n, z / n)
+            self._bias[0] += d[6]
+            self._bias[1] += d[7]
+
+    def _wave_statistics(self, an: float, ae: float, dt: float) -> None:
         """Running mean square of the wave velocity [m/s, n]: the horizontal acceleration
         [m/s², n] less its slow mean, through a leaky integrator (:data:`LEAK_TAU`); exponential
         mean, time constant :data:`STATS_TAU`, its weight 1 − (1 − β)^k kept to correct the start."""
-        if self.acc_mean is None:
-            self.acc_mean = a_h.copy()
-        self.acc_mean += (dt / LEAK_TAU) * (a_h - self.acc_mean)
-        self.leak_v += (a_h - self.acc_mean - self.leak_v / LEAK_TAU) * dt
+        if self._acc_mean is None:
+            self._acc_mean = [an, ae]
+        m, lv, ms = self._acc_mean, self._leak_v, self._ms_v
+        k = dt / LEAK_TAU
         beta = dt / STATS_TAU
-        self.ms_v += beta * (self.leak_v * self.leak_v - self.ms_v)
+        for i, a in ((0, an), (1, ae)):
+            m[i] += k * (a - m[i])
+            lv[i] += (a - m[i] - lv[i] / LEAK_TAU) * dt
+            ms[i] += beta * (lv[i] * lv[i] - ms[i])
         self.stats_weight += beta * (1.0 - self.stats_weight)
         self.stats_time += dt
 
@@ -419,26 +585,29 @@ class AttitudeEstimator:
 
     def _set_gyro_process_noise(self) -> None:
         """The gyro's entries of the process-noise density: white noise on ε, Gauss–Markov
-        driving noise 2σ_b²/τ_b on the bias."""
+        driving noise 2σ_b²/τ_b on the bias (and Q Δt from them)."""
         self._q_diag[4, 4] = self._q_diag[5, 5] = self.gyro_noise_used ** 2
         self._q_diag[6, 6] = self._q_diag[7, 7] = 2.0 * self.gyro_bias_sigma_used ** 2 / self.params.gyro_bias_tau
+        if self._dt is not None:
+            np.multiply(self._q_diag, self._dt, out=self._q_dt)
 
     def _result(self, valid: bool, warning: str | None) -> AttitudeResult:
-        roll, pitch, yaw = quat_to_euler(self.q)
-        return AttitudeResult(roll, pitch, yaw, tuple(self.q.tolist()), tuple(self.bias.tolist()), valid, warning)
+        q = self._q
+        roll, pitch, yaw = quat_to_euler(q)
+        return AttitudeResult(roll, pitch, yaw, q, tuple(self._bias), valid, warning)
 
     # ---- FMU state ---------------------------------------------------------------------------
     def get_state(self) -> dict:
         """JSON-serialisable internal state (quaternion, bias, velocity, filter, levelling)."""
         return {
-            "q": self.q.tolist(), "bias": self.bias.tolist(), "vel": self.vel.tolist(), "pos": self.pos.tolist(),
-            "last_gyro": None if self.last_gyro is None else self.last_gyro.tolist(),
-            "last_acc": None if self.last_acc is None else self.last_acc.tolist(),
-            "levelling": self.levelling, "level_steps": self.level_steps, "level_sum": self.level_sum.tolist(),
-            "q_rel": self.q_rel.tolist(), "since_aid": self.since_aid,
+            "q": list(self._q), "bias": list(self._bias), "vel": list(self._vel), "pos": list(self._pos),
+            "last_gyro": None if self._last_gyro is None else list(self._last_gyro),
+            "last_acc": None if self._last_acc is None else list(self._last_acc),
+            "levelling": self.levelling, "level_steps": self.level_steps, "level_sum": list(self._level_sum),
+            "q_rel": list(self._q_rel), "since_aid": self.since_aid,
             "kf_x": self.kf.x.tolist(), "kf_P": self.kf.P.tolist(), "kf_R": self.kf.R.tolist(),
-            "acc_mean": None if self.acc_mean is None else self.acc_mean.tolist(),
-            "leak_v": self.leak_v.tolist(), "ms_v": self.ms_v.tolist(),
+            "acc_mean": None if self._acc_mean is None else list(self._acc_mean),
+            "leak_v": list(self._leak_v), "ms_v": list(self._ms_v),
             "stats_weight": self.stats_weight, "stats_time": self.stats_time,
             "gyro_meter": self.gyro_meter.get_state(), "gyro_noise_used": self.gyro_noise_used,
             "gyro_bias_sigma_used": self.gyro_bias_sigma_used,
@@ -446,21 +615,26 @@ class AttitudeEstimator:
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
-        self.q = np.array(s["q"])
-        self.bias = np.array(s["bias"])
-        self.vel = np.array(s["vel"])
-        self.pos = np.array(s["pos"])
-        self.last_gyro = None if s["last_gyro"] is None else np.array(s["last_gyro"])
-        self.last_acc = None if s["last_acc"] is None else np.array(s["last_acc"])
+        floats = lambda v: [float(x) for x in v]  # noqa: E731
+        self._q = tuple(floats(s["q"]))
+        self._bias = floats(s["bias"])
+        self._vel = floats(s["vel"])
+        self._pos = floats(s["pos"])
+        self._last_gyro = None if s["last_gyro"] is None else tuple(floats(s["last_gyro"]))
+        self._last_acc = None if s["last_acc"] is None else tuple(floats(s["last_acc"]))
         self.levelling, self.level_steps = bool(s["levelling"]), int(s["level_steps"])
-        self.level_sum, self.q_rel = np.array(s["level_sum"]), np.array(s["q_rel"])
+        self._level_sum, self._q_rel = floats(s["level_sum"]), tuple(floats(s["q_rel"]))
         self.since_aid = float(s["since_aid"])
-        self.kf.x, self.kf.P, self.kf.R = np.array(s["kf_x"]), np.array(s["kf_P"]), np.array(s["kf_R"])
-        self.acc_mean = None if s["acc_mean"] is None else np.array(s["acc_mean"])
-        self.leak_v, self.ms_v = np.array(s["leak_v"]), np.array(s["ms_v"])
+        # x is zero between steps (the update's error is injected and reset)
+        self.kf.x = np.zeros((8, 1))
+        self.kf.P = np.array(s["kf_P"], dtype=float)
+        self.kf.R = np.array(s["kf_R"], dtype=float)
+        self._acc_mean = None if s["acc_mean"] is None else floats(s["acc_mean"])
+        self._leak_v, self._ms_v = floats(s["leak_v"]), floats(s["ms_v"])
         self.stats_weight, self.stats_time = float(s["stats_weight"]), float(s["stats_time"])
         self.gyro_meter.set_state(s["gyro_meter"])
         self.gyro_noise_used, self.gyro_bias_sigma_used = float(s["gyro_noise_used"]), float(s["gyro_bias_sigma_used"])
+        self._dt = None
         self._set_gyro_process_noise()
 
 
