@@ -226,11 +226,13 @@ class AidedBand:
             # decorrelated increment form: Ā = A − J C over the tilt's column too
             self.F[:n, d + 2] = -self.J[:n] * t.gain
         if self.angle is not None:          # the wave tilt's elements, without their offset
-            a, s = n + self.n_extra, self.angle.block
+            a = n + self.n_extra
             self.F[a:, a:] = self.angle.A[:-1, :-1]
             self.Q[a:, a:] = self.angle.Q[:-1, :-1]
-            self._angle_blocks = np.stack([self.F[a + i:a + i + s, a + i:a + i + s]
-                                           for i in range(0, self.n_angle, s)])
+        self._segments = self._block_segments()
+        self._work: np.ndarray | None = None    # the prediction's work array (n × n)
+        nz = np.flatnonzero(self.J)
+        self._j_rows = int(nz[-1]) + 1 if len(nz) else 0    # J is zero below this row
         self.rows = np.zeros((2, size))     # position and velocity of the axis
         if m is not None:
             self.rows[:, :n] = m.heave_rows
@@ -376,28 +378,90 @@ class AidedBand:
         s = float(h @ ph) + r
         k = ph / s
         self.x = self.x + k * (z - float(h @ self.x))
-        self.P = self.P - np.outer(k, ph)
+        if not self.P.flags.c_contiguous:
+            self.P = np.ascontiguousarray(self.P)
+        # P ← P − k phᵀ in place (numpy's outer product, not BLAS dger: OpenBLAS runs a rank-one
+        # update of this size on two threads, which costs milliseconds when the other core is busy)
+        np.subtract(self.P, np.multiply.outer(k, ph, out=self._scratch()), out=self.P)
+
+    def _block_segments(self) -> list[tuple[int, int, np.ndarray]] | None:
+        """The block-diagonal part D = F + J Cᵀ of the transition (:meth:`_predict`) as
+        contiguous segments (first row, end row, (k, s, s) blocks): the band elements (blocks
+        of ``model.block``), the offset with the drift and tilt states (one block), the wave
+        tilt's elements (blocks of ``angle.block``). None if D has an entry outside them (then
+        the product is taken densely)."""
+        d = self.F + np.outer(self.J, self.C)
+        size = len(d)
+        cuts: list[tuple[int, int, int]] = []           # (first row, end row, block size)
+        tail = 0
+        if self.model is not None:
+            tail = self.n_band - 1
+            cuts.append((0, tail, self.model.block))
+        b = self.n_band + self.n_extra
+        cuts.append((tail, b, b - tail))
+        if self.angle is not None:
+            cuts.append((b, size, self.angle.block))
+        mask = np.ones((size, size), dtype=bool)
+        segments = []
+        for a0, a1, s in cuts:
+            if a1 == a0:
+                continue
+            if (a1 - a0) % s:
+                return None
+            for i in range(a0, a1, s):
+                mask[i:i + s, i:i + s] = False
+            segments.append((a0, a1, np.stack([d[i:i + s, i:i + s] for i in range(a0, a1, s)])))
+        return segments if not np.any(d[mask]) else None
+
+    def _scratch(self) -> np.ndarray:
+        """An n × n work array for :meth:`_predict` and :meth:`_update` (kept between steps)."""
+        size = len(self.x)
+        if self._work is None or len(self._work) != size:
+            self._work = np.empty((size, size))
+        return self._work
+
+    def _block_times(self, m: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """D @ ``m`` into ``out`` (D of :meth:`_block_segments`)."""
+        for a0, a1, blocks in self._segments:
+            k, s, _ = blocks.shape
+            np.matmul(blocks, m[a0:a1].reshape(k, s, -1), out=out[a0:a1].reshape(k, s, -1))
+        return out
 
     def _predict(self, y: float) -> None:
         """x ← F x + J y, P ← F P Fᵀ + Q.
 
-        With a wave-tilt band F is block-diagonal, [F₁ 0; 0 F₂], and F₂ is itself a chain of
-        independent elements (``angle.block`` states each), so the product is taken by parts
-        and F₂'s by element (:func:`blocks_times`): O(n₁³ + n₁²n₂ + n₂²·block) instead of
-        O((n₁ + n₂)³) (n₁ about 100, n₂ up to about 200 on the paper-001 set-up)."""
+        F is a block-diagonal D (the band's and the wave tilt's elements, ``block`` states
+        each, and the offset, drift and tilt states) less the rank-one feed-through of the
+        increment form, F = D − J Cᵀ (Ā = A − J C, :mod:`.oscillator_bank`; the tilt's column
+        −J·gain). So, with w = P C, u = D w and s = Cᵀ w,
+
+            F P Fᵀ = D P Dᵀ − v Jᵀ − J vᵀ,   v = u − (s/2) J,
+
+        with D P Dᵀ = D (D P)ᵀ taken element by element: O(n²·block) instead of the dense
+        O(n³) (n up to about 170 on the paper-001 set-up), equal to rounding (a test compares
+        it with the dense product). Should D have an entry outside its blocks, the product is
+        the dense one."""
         self.x = self.F @ self.x + self.J * y
-        if self.angle is None:
+        if self._segments is None:
             p = self.F @ self.P @ self.F.T + self.Q
-        else:
-            b = self.n_band + self.n_extra
-            f1, blocks, pm = self.F[:b, :b], self._angle_blocks, self.P
-            p = np.empty_like(pm)
-            p[:b, :b] = f1 @ pm[:b, :b] @ f1.T
-            p[:b, b:] = blocks_times(blocks, (f1 @ pm[:b, b:]).T).T
-            p[b:, :b] = p[:b, b:].T
-            p[b:, b:] = blocks_times(blocks, blocks_times(blocks, pm[b:, b:]).T).T
-            p += self.Q
-        self.P = 0.5 * (p + p.T)
+            self.P = 0.5 * (p + p.T)
+            return
+        pm = self.P if self.P.flags.c_contiguous else np.ascontiguousarray(self.P)
+        a = self._scratch()
+        w = pm @ self.C
+        v = self._block_times(w, np.empty_like(w))
+        v -= (0.5 * float(self.C @ w)) * self.J
+        self._block_times(pm, a)                            # D P
+        np.copyto(pm, a.T)                                  # (D P)ᵀ (P is not needed again)
+        self._block_times(pm, a)                            # D P Dᵀ = D (D P)ᵀ
+        # a ← a − 2 v Jᵀ in place (the rows where J is not zero), whose symmetric part is the
+        # rank-two term
+        j = self._j_rows
+        a[:j] -= np.multiply.outer(2.0 * self.J[:j], v)
+        np.add(a, a.T, out=pm)
+        pm *= 0.5
+        pm += self.Q
+        self.P = pm
 
     def restart_drift(self) -> None:
         """Forget the drift and the tilt (the fusion re-initialised on a fix: a real reposition,
