@@ -40,6 +40,7 @@ Beyond the paper, for speed and long records:
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -73,7 +74,7 @@ def rotations(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.ndarra
     ], -2)
 
 
-def tilt_correct(f_b: np.ndarray, euler: np.ndarray, method: str = "exact") -> np.ndarray:
+def tilt_correct(f_b: np.ndarray, euler: np.ndarray, method: str = "exact", rot: np.ndarray | None = None) -> np.ndarray:
     """Acceleration without gravity from specific force and attitude (paper 000, eqs. 10-15).
 
     Parameters
@@ -85,6 +86,8 @@ def tilt_correct(f_b: np.ndarray, euler: np.ndarray, method: str = "exact") -> n
     method : {"exact", "small_angle"}
         ``"exact"``: a_n = R_nb f_b + g_n [m/s², NED]. ``"small_angle"``: eq. 15,
         a ≈ f_b + g·[−θ, φ, 1] (sensor axes; yaw is not used).
+    rot : numpy.ndarray, optional
+        (N, 3, 3) :func:`rotations` of ``euler``, if already computed.
 
     Returns
     -------
@@ -98,12 +101,13 @@ def tilt_correct(f_b: np.ndarray, euler: np.ndarray, method: str = "exact") -> n
         raise ShapeError(f"euler must have the length of f_b ({len(f_b)}), got {len(euler)}")
     if method == "small_angle":
         return f_b + G * np.column_stack((-euler[:, 1], euler[:, 0], np.ones(len(f_b))))
-    rot = rotations(euler[:, 0], euler[:, 1], euler[:, 2])
+    if rot is None:
+        rot = rotations(euler[:, 0], euler[:, 1], euler[:, 2])
     return np.einsum("nij,nj->ni", rot, f_b) + np.array([0.0, 0.0, G])
 
 
 def lever_arm_offset(euler: np.ndarray, lever_arm: np.ndarray, dt: float | None = None,
-                     cutoff: float | None = None) -> np.ndarray:
+                     cutoff: float | None = None, rot: np.ndarray | None = None) -> np.ndarray:
     """The part of the sensor's offset from the COG, R_nb(t) l [m, NED], that eq. 32 subtracts
     from a reconstructed displacement to move it to the COG.
 
@@ -121,13 +125,24 @@ def lever_arm_offset(euler: np.ndarray, lever_arm: np.ndarray, dt: float | None 
         (3,) sensor position relative to the COG, body frame [m].
     dt, cutoff : float, optional
         Sample interval [s] and screening frequency [Hz].
+    rot : numpy.ndarray, optional
+        (N, 3, 3) :func:`rotations` of ``euler``, if already computed.
     """
     euler = _as_n3("euler", euler)
-    off = rotations(euler[:, 0], euler[:, 1], euler[:, 2]) @ np.asarray(lever_arm, dtype=float)
+    if rot is None:
+        rot = rotations(euler[:, 0], euler[:, 1], euler[:, 2])
+    off = rot @ np.asarray(lever_arm, dtype=float)
     if dt is None or cutoff is None or len(off) < 30:
         return off - off.mean(axis=0)
-    sos = signal.butter(4, cutoff, btype="highpass", fs=1.0 / dt, output="sos")
+    sos = _butter_sos(4, cutoff, "highpass", 1.0 / dt)
     return signal.sosfiltfilt(sos, off, axis=0)
+
+
+@lru_cache(maxsize=16)
+def _butter_sos(order: int, wn: float, btype: str, fs: float | None) -> np.ndarray:
+    """Butterworth second-order sections (``scipy.signal.butter``), designed once per setting
+    and shared: ``sosfiltfilt`` does not change its ``sos``."""
+    return signal.butter(order, wn, btype=btype, fs=fs, output="sos")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -498,8 +513,8 @@ def _least_squares_amplitudes(x: np.ndarray, lam: np.ndarray, dt: float, with_fi
         return (zero, np.zeros(n)) if with_fit else zero
     upper = lam.imag > 0
     real = lam.imag == 0
-    partner = [np.nonzero(lam == np.conj(v))[0] for v in lam[upper]]
-    paired = all(len(j) == 1 for j in partner) and upper.sum() * 2 + real.sum() == len(lam)
+    match = lam[None, :] == np.conj(lam[upper])[:, None]  # row i: the exact partners of the i-th upper pole
+    paired = bool(np.all(match.sum(axis=1) == 1)) and upper.sum() * 2 + real.sum() == len(lam)
     if not paired:
         return _complex_least_squares(x, lam, dt, with_fit)
     basis_poles = np.concatenate((lam[upper], lam[real]))
@@ -518,7 +533,7 @@ def _least_squares_amplitudes(x: np.ndarray, lam: np.ndarray, dt: float, with_fi
     g_up = 0.5 * (coef[:m] - 1j * coef[m:2 * m])
     if m:
         gamma[np.nonzero(upper)[0]] = g_up
-        gamma[np.concatenate(partner)] = np.conj(g_up)
+        gamma[np.argmax(match, axis=1)] = np.conj(g_up)
     gamma[np.nonzero(real)[0]] = coef[2 * m:]
     return (gamma, fit) if with_fit else gamma
 
@@ -592,7 +607,7 @@ def lowpass_decimate(x: np.ndarray, q: int) -> np.ndarray:
     Records shorter than the filter's padding (54 samples) are only sub-sampled."""
     if q == 1 or len(x) <= 27 * 2:  # too short for the filter's padding: plain sub-sampling
         return np.asarray(x, dtype=float)[::q]
-    sos = signal.butter(8, 0.8 / q, output="sos")
+    sos = _butter_sos(8, 0.8 / q, "lowpass", None)
     return signal.sosfiltfilt(sos, x, axis=0)[::q]
 
 

@@ -53,7 +53,7 @@ from ..numerics import one_blas_thread
 from ..samples import MAX_SPECIFIC_FORCE, MAX_TILT, MAX_YAW, angles_beyond_limit, force_beyond_limit
 from .decomposition import (
     TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, lever_arm_offset,
-    lowpass_decimate, tilt_correct,
+    lowpass_decimate, rotations, tilt_correct,
 )
 
 log = logging.getLogger(__name__)
@@ -216,7 +216,8 @@ class DisplacementReconstructor:
     def _refit(self) -> None:
         p, dt = self.params, self.dt
         euler = self._ordered(self.euler)
-        acc = tilt_correct(self._ordered(self.acc), euler, p.tilt)
+        rot = rotations(euler[:, 0], euler[:, 1], euler[:, 2])
+        acc = tilt_correct(self._ordered(self.acc), euler, p.tilt, rot)
         self.t_start = (self.k - self.n_win) * dt
         xd = lowpass_decimate(acc, self.q)
         models = []
@@ -227,7 +228,7 @@ class DisplacementReconstructor:
             lam, gam = d.lam[d.kept], d.gamma[d.kept]
             models.append((lam, gam / lam ** 2, gam / lam))
         self.models = models
-        self.arm_band = lever_arm_offset(euler, self.lever, dt, p.cutoff)
+        self.arm_band = lever_arm_offset(euler, self.lever, dt, p.cutoff, rot)
         self.arm_end = self._arm(self.k - 1)
         self.fit_bad_fraction = float(self.bad.mean())
         self._drop_table()
