@@ -77,6 +77,51 @@ def antenna_attitude(positions: np.ndarray, arms: np.ndarray) -> AntennaFix | st
     return AntennaFix(r, cog, float(math.sqrt(np.mean(np.sum(resid ** 2, axis=1)))), pc)
 
 
+def matrix_rotvec(m: np.ndarray) -> tuple[float, float, float]:
+    """Rotation vector [rad] of the rotation matrix ``m``: scipy's
+    ``Rotation.from_matrix(m).as_rotvec()`` written out in floats (its quaternion of the
+    largest of the diagonal and the trace, normalised and made w ≥ 0, then 2·atan2(|v|, w)
+    and its small-angle series below 1e-3 rad). A matrix that scipy would orthogonalise first
+    (its Gram matrix not I to 1e-12) or reject is handed to scipy itself. For the fix-to-fix
+    rotations at every GNSS epoch and the coast's tilt at every band step, where scipy costs
+    tens of µs a call; a test checks it against scipy.
+
+    Examples
+    --------
+    >>> [round(v, 12) for v in matrix_rotvec(Rotation.from_rotvec([0.1, -0.2, 0.3]).as_matrix())]
+    [0.1, -0.2, 0.3]
+    """
+    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
+    gram = (a * a + b * b + c * c - 1.0, a * d + b * e + c * f, a * g + b * h + c * i,
+            d * d + e * e + f * f - 1.0, d * g + e * h + f * i, g * g + h * h + i * i - 1.0)
+    if not (abs(gram[0]) <= 1e-12 + 1e-5 and abs(gram[3]) <= 1e-12 + 1e-5 and abs(gram[5]) <= 1e-12 + 1e-5
+            and abs(gram[1]) <= 1e-12 and abs(gram[2]) <= 1e-12 and abs(gram[4]) <= 1e-12) or (
+            a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g) <= 0.0):
+        return tuple(Rotation.from_matrix(m).as_rotvec().tolist())
+    tr = a + e + i
+    big = max(a, e, i, tr)
+    if a == big:
+        q = (1.0 - tr + 2.0 * a, d + b, g + c, h - f)
+    elif e == big:
+        q = (d + b, 1.0 - tr + 2.0 * e, h + f, c - g)
+    elif i == big:
+        q = (g + c, h + f, 1.0 - tr + 2.0 * i, d - b)
+    else:
+        q = (h - f, c - g, d - b, 1.0 + tr)
+    x, y, z, w = q
+    if w < 0.0 or (w == 0.0 and (x < 0.0 or (x == 0.0 and (y < 0.0 or (y == 0.0 and z < 0.0))))):
+        x, y, z, w = -x, -y, -z, -w
+    norm = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    angle = 2.0 * math.atan2(math.sqrt(x * x + y * y + z * z), w)
+    if angle <= 1e-3:
+        a2 = angle * angle
+        scale = 2.0 + a2 / 12.0 + 7.0 * a2 * a2 / 2880.0
+    else:
+        scale = angle / math.sin(angle / 2.0)
+    return scale * x, scale * y, scale * z
+
+
 def antenna_attitude_std(arms: np.ndarray, rot: np.ndarray, sigma_h: float, sigma_v: float) -> np.ndarray:
     """Standard deviations [rad] of the least-squares antenna attitude's error about the N, E
     and D axes, to first order, for independent antenna errors of ``sigma_h`` (north, east) and

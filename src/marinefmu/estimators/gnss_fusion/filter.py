@@ -109,7 +109,8 @@ from scipy.spatial.transform import Rotation
 from ...errors import ParameterError, check_choice, check_range, check_vector
 from ...frames import GRAVITY_N, cross3, euler_to_quat, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
 from ..samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
-from .antenna_attitude import ANTENNAS, DEFAULT_ANTENNAS, MIN_SPREAD, AntennaFix, antenna_attitude, antenna_attitude_std
+from .antenna_attitude import (ANTENNAS, DEFAULT_ANTENNAS, MIN_SPREAD, AntennaFix, antenna_attitude, antenna_attitude_std,
+                               matrix_rotvec)
 from .error_model import FusionError, pi_gains, skew
 from .wave_coast import WaveCoast
 
@@ -452,7 +453,7 @@ def pi_pull(q: np.ndarray, bias: np.ndarray, rot_fix: np.ndarray, dt_fix: float,
         The corrected attitude and bias.
     """
     rot = quat_to_rot(q)
-    e_n = Rotation.from_matrix(rot_fix @ rot.T).as_rotvec()  # small rotation est → fix, NED
+    e_n = np.array(matrix_rotvec(rot_fix @ rot.T))  # small rotation est → fix, NED
     k_p, k_i = pi_gains(dt_fix, tau)
     q = quat_mul(quat_from_rotvec((k_p if alpha is None else alpha) * e_n), q)
     return q / np.linalg.norm(q), bias - k_i * (rot.T @ e_n)
@@ -807,11 +808,11 @@ class GnssAccFusion:
         if self._coast_gyro():
             rot_c, bias_c = quat_to_rot(self.q_coast), self.coast_bias.copy()
             if self.coaster.tilt is not None:
-                self.coaster.attitude_fix(Rotation.from_matrix(sol.rot @ rot_c.T).as_rotvec(), att_std)
+                self.coaster.attitude_fix(np.array(matrix_rotvec(sol.rot @ rot_c.T)), att_std)
             self.q_coast, self.coast_bias = pi_pull(self.q_coast, self.coast_bias, sol.rot, since, p.coast_attitude_tau)
             if self.coaster.tilt is not None:
                 # true = exp(e)·R = exp(e')·R' → e' = e + rotvec(R R'ᵀ); δ = −R(b − b̂)
-                d_eps = Rotation.from_matrix(rot_c @ quat_to_rot(self.q_coast).T).as_rotvec()
+                d_eps = np.array(matrix_rotvec(rot_c @ quat_to_rot(self.q_coast).T))
                 self.coaster.shift_tilt(d_eps, rot_c @ (self.coast_bias - bias_c))
         self.since_fix = 0.0
         self.rejecting = 0.0
@@ -932,7 +933,7 @@ class GnssAccFusion:
         p = self.run_params
         if p.propagation == "hold":
             if dt_fix <= HOLD_OVERDUE * self.fix_interval:     # held since the last fix (not the gyro's)
-                self.error.held_rotation(Rotation.from_matrix(rot_fix @ quat_to_rot(self.q).T).as_rotvec(), dt_fix, fix_std)
+                self.error.held_rotation(np.array(matrix_rotvec(rot_fix @ quat_to_rot(self.q).T)), dt_fix, fix_std)
             self.q = Rotation.from_matrix(rot_fix).as_quat(scalar_first=True)
             return      # the error's ε was reset with the fix's position (FusionError.fix)
         alpha = np.minimum(pi_gains(dt_fix, p.attitude_tau)[0], self.error.attitude_gain(fix_std))

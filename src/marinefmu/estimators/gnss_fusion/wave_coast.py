@@ -65,8 +65,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...frames import G, nav_tilt
+from ...frames import G
 from .aided_band import ANGLE_SIGMA, AidedBand, Tilt, drift_noise
+from .antenna_attitude import matrix_rotvec
 from ..numerics import one_blas_thread
 from ..heave.bank import OscillatorBankHeave
 from ..heave.common import HeaveObserverParams
@@ -111,6 +112,15 @@ BAND_SMOOTHING = 1
 #: resonance, which narrower elements than the heave observer's 0.1 follow better
 #: (docs/decisions/gnss-fusion-coast.md).
 ANGLE_DAMPING = 0.05
+
+
+def nav_tilt(rot: np.ndarray) -> tuple[float, float]:
+    """:func:`marinefmu.frames.nav_tilt`, the tilt of R_nb about N and E [rad], with its
+    rotation vector in floats (:func:`~.antenna_attitude.matrix_rotvec`, equal to scipy's):
+    once per band step."""
+    yaw = math.atan2(rot[1, 0], rot[0, 0])
+    c, s = math.cos(yaw), math.sin(yaw)
+    return matrix_rotvec(rot @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]))[:2]
 
 
 def observe(obs: OscillatorBankHeave, value: float, dt: float) -> None:
@@ -233,9 +243,9 @@ class WaveCoast:
         if attitude is None:
             raise ValueError("WaveCoast.add needs the attitude with tilt_band")
         theta = nav_tilt(np.asarray(attitude, dtype=float))
-        if not np.all(np.isfinite(theta)):
+        if not (math.isfinite(theta[0]) and math.isfinite(theta[1])):
             return          # not expected: the fusion holds its last good attitude on a bad sample
-        self.angles = (self.angles + [theta])[-3:]
+        self.angles = (self.angles + [np.array(theta)])[-3:]
         if len(self.angles) < 3:
             return
         h = self.block * self.dt
