@@ -52,7 +52,7 @@ from ...frames import G, rot_nb
 from ..numerics import one_blas_thread
 from ..samples import MAX_SPECIFIC_FORCE, MAX_TILT, MAX_YAW, angles_beyond_limit, force_beyond_limit
 from .decomposition import (
-    TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, lever_arm_offset,
+    TILT_CHOICES, Decomposition, check_reconstruction_params, decimation_factor, decompose, exp_grid, lever_arm_offset,
     lowpass_decimate, rotations, tilt_correct,
 )
 
@@ -270,9 +270,9 @@ class DisplacementReconstructor:
     def _centre(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """:meth:`estimate_at` (``delay``) of the latest sample, from a block of
         :data:`TABLE_BLOCK` steps of the model's values at the window centre: the model is
-        fixed between refits and the centre advances one sample a step, so the block's
-        exponentials are those :meth:`_eval` would take one step at a time (the same
-        arguments; only the order of the sums over components differs, by rounding)."""
+        fixed between refits and the centre advances one sample a step, so the block is
+        e^{λ(t₀ + kΔt)} = e^{λt₀} e^{λkΔt} on a uniform grid (:func:`~.decomposition.exp_grid`),
+        which equals the exponentials :meth:`_eval` takes one step at a time to a few ulp."""
         j = int(round(0.5 * self.params.window / self.dt))
         m = self.k - self._tab_k0
         if not 0 <= m < len(self._tab):
@@ -293,15 +293,15 @@ class DisplacementReconstructor:
         dt, n = self.dt, TABLE_BLOCK
         k_fit = int(round(self.t_start / dt)) + self.n_win  # the sample count at the refit
         k0 = k_fit + (self.k - k_fit) // n * n
-        k = np.arange(k0 - 1 - j, k0 - 1 - j + n)  # absolute sample indices of the centre
-        t_rel = k * dt - self.t_start
+        t_rel = (k0 - 1 - j) * dt - self.t_start  # of the block's first centre sample
         tab = np.zeros((n, 6))
         with one_blas_thread():
             for axis, (lam, c2, c1) in enumerate(self.models):
                 if len(lam):
-                    e = np.exp(np.multiply.outer(t_rel, lam))
-                    tab[:, axis] = (e @ c2).real
-                    tab[:, 3 + axis] = (e @ c1).real
+                    e = exp_grid(lam, dt, n)
+                    shift = np.exp(lam * t_rel)
+                    tab[:, axis] = (e @ (c2 * shift)).real
+                    tab[:, 3 + axis] = (e @ (c1 * shift)).real
         self._tab, self._tab_k0 = tab, k0
 
     def _outputs(self, warning: str | None) -> DisplacementReconstructorResult:
