@@ -34,6 +34,14 @@ Design, at every ``peak_interval`` after the first ``window`` (the window grows 
    of the acceleration less the window's mean (with the bias steps found, the ``offset``
    output; the weights sum to zero, so it changes no output).
 
+Cost per step: every step, the ring writes and the L + 1 reads of the running sum (step 3)
+and the point transfer; every :data:`STEP_CHECK` s the bias-step search; every
+``peak_interval`` the design. The design's correlation sums Σ c(ω) e^{jωτ} over the frequency
+grid and the L lags are one inverse FFT per right-hand side on the grid folded modulo its
+period in ωτ (:func:`correlation_sums`), not (K, L) tables of cosines and sines: the grid is
+uniform and its step times the tap spacing is 2π/N, so the two are the same sum, equal to the
+rounding of the tables' own phases.
+
 Bias steps. The output has no gain at zero frequency, so a constant bias never reaches it, but a
 bias *step* in mid-run would stay in the spectrum window as a 1/ω² density, taken for sea at low
 frequency for as long as the window holds it (``window_max``, 20 minutes by default), and the
@@ -62,6 +70,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import replace
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -127,6 +136,43 @@ def sea_heave_density(spectrum: Spectrum, acc_noise: float, offset_noise: float,
     return sea
 
 
+def block_mean_response(w: np.ndarray, block: int, dt: float) -> np.ndarray:
+    """Frequency response of the mean of ``block`` consecutive samples ``dt`` [s] apart, newest
+    at lag 0: (1/M) Σ_m e^{−jωmΔt} = e^{−jω(M−1)Δt/2} sin(MωΔt/2) / (M sin(ωΔt/2)) (the
+    geometric sum in closed form, without its cancellation at small ωΔt), at ``w`` [rad/s] > 0
+    below 2π/Δt."""
+    x = 0.5 * w * dt
+    return np.exp(-1j * (block - 1) * x) * (np.sin(block * x) / (block * np.sin(x)))
+
+
+def correlation_sums(coef: np.ndarray, w: np.ndarray, taps: int, spacing: float) -> np.ndarray:
+    """Σ_k c_k e^{jω_k τ_j} for the lags τ_j = j·``spacing``, j = 0 … ``taps`` − 1, of rows of
+    coefficients ``coef`` (R, K) at uniform frequencies ``w`` (K,) [rad/s].
+
+    With ω_k = ω_0 + kΔω and ΔωT = 2πp/N for integers p, N (T the spacing), the sum is
+    e^{jω_0τ_j} Σ_m V_m e^{2πjmj/N} with V_m the sum of the c_k with pk ≡ m (mod N): one
+    inverse FFT of N points per row instead of a (K, L) table of cosines and sines. That holds
+    for the grids :func:`wiener_taps` makes (Δω = π/(2·memory): p = 1, N = 4L; or the window's
+    bin 2π/(nΔt): p = M, N = n), to within the rounding of ω_k τ_j that the table itself
+    has; on any other grid the table is used.
+    """
+    d_omega = float(w[1] - w[0]) if len(w) > 1 else 0.0
+    theta = d_omega * spacing / (2.0 * math.pi)
+    tau = np.arange(taps) * spacing
+    ratio = Fraction(theta).limit_denominator(1 << 18) if theta > 0.0 else Fraction(0)
+    p, n = ratio.numerator, ratio.denominator
+    # the phase error of the folded sum, k·j·|Δθ|, within the table's own: a few ulp of max ωτ
+    if p > 0 and len(w) * taps * abs(2.0 * math.pi * (theta - p / n)) <= 8.0 * np.finfo(float).eps * w[-1] * tau[-1]:
+        idx = (p * np.arange(len(w))) % n
+        folded = np.zeros((len(coef), n), dtype=complex)
+        for r in range(len(coef)):
+            folded[r] = np.bincount(idx, coef[r].real, n) + 1j * np.bincount(idx, coef[r].imag, n)
+        spectrum = np.fft.ifft(folded, axis=1) * n
+        return np.exp(1j * w[0] * tau) * spectrum[:, np.arange(taps) % n]
+    wt = np.outer(w, tau)
+    return coef @ (np.cos(wt) + 1j * np.sin(wt))
+
+
 def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: int, taps: int, lag: float,
                 acc_noise: float, offset_noise: float, unwanted: np.ndarray | None = None) -> np.ndarray:
     """Step 2: the weights of the four outputs on the block means.
@@ -173,19 +219,20 @@ def wiener_taps(omega: np.ndarray, heave_density: np.ndarray, dt: float, block: 
     w = np.arange(omega[0], top + d_omega, d_omega)
     s_z = np.interp(w, omega, heave_density)
     extra = np.zeros_like(w) if unwanted is None else np.interp(w, omega, unwanted)
-    mean_response = np.exp(-1j * np.outer(w, np.arange(block) * dt)).mean(axis=1)
+    mean_response = block_mean_response(w, block, dt)
     b = -(w**2) * mean_response
-    tau = np.arange(taps) * block * dt
-    wt = np.outer(w, tau)
-    cos_wt, sin_wt = np.cos(wt), np.sin(wt)        # cos(ωτ − β) = cos ωτ cos β + sin ωτ sin β: two (K, L) tables
     acc_density = np.abs(mean_response) ** 2 * (s_z * w**4 + extra + offset_noise**2 / (math.pi * w**2))
-    auto = (acc_density * d_omega) @ cos_wt
-    auto[0] += acc_noise**2 / (block * dt)
-    cross = []
+    # Σ_ω c(ω) e^{jωτ} for R (c real) and for each r (c = weight·e^{−j(β − shift)}):
+    # Re Σ c e^{jωτ} = Σ Re c cos ωτ − Im c sin ωτ, i.e. Σ weight cos(ωτ − β + shift)
+    coefficients = [acc_density * d_omega]
     for delay in (0.0, lag):
         beta = w * delay + np.angle(b)
         for weight, shift in ((s_z * np.abs(b) * d_omega, 0.0), (s_z * w * np.abs(b) * d_omega, 0.5 * math.pi)):
-            cross.append((weight * np.cos(beta - shift)) @ cos_wt + (weight * np.sin(beta - shift)) @ sin_wt)
+            coefficients.append(weight * np.cos(beta - shift) - 1j * (weight * np.sin(beta - shift)))
+    sums = correlation_sums(np.array(coefficients), w, taps, block * dt)
+    auto = sums[0].real
+    auto[0] += acc_noise**2 / (block * dt)
+    cross = list(sums[1:].real)
     solved = solve_toeplitz(auto, np.column_stack([*cross, np.ones(taps)]))
     weights, ones = solved[:, :4], solved[:, 4]                         # R⁻¹r (L, 4), R⁻¹1
     weights -= np.outer(ones, weights.sum(axis=0) / ones.sum())         # no gain at zero frequency
