@@ -62,7 +62,11 @@ from ...errors import check_choice, check_int, check_range, check_vector
 from ...frames import G
 from .band_bank import BAND_VARIANCES
 from .oscillator_bank import DISCRETISATIONS, MEASUREMENTS
-from ..samples import angles_beyond_limit, force_beyond_limit
+from ..samples import MAX_SPECIFIC_FORCE, MAX_TILT, angles_beyond_limit, force_beyond_limit
+
+#: Squared specific force [m²/s⁴] below which a finite sample passes :func:`read_sample` on float
+#: comparisons alone (a margin inside :data:`~marinefmu.estimators.samples.MAX_SPECIFIC_FORCE`).
+_FORCE_PASS2 = (0.99 * MAX_SPECIFIC_FORCE) ** 2
 
 
 class SilentLog:
@@ -313,20 +317,29 @@ def central_rate(prev: tuple[float, float], nxt: tuple[float, float], dt: float)
     return (nxt[0] - prev[0]) / (2 * dt), (nxt[1] - prev[1]) / (2 * dt)
 
 
-def read_sample(acc: Any, roll: float, pitch: float) -> tuple[np.ndarray, float, float, str | None]:
+def read_sample(acc: Any, roll: float, pitch: float) -> tuple[Any, float, float, str | None]:
     """One IMU sample as the heave estimators take it: (f_b (3,) [m/s²], roll, pitch [rad],
-    the reason it is bad or None). ``acc`` is f_z or (3,) f_b; another shape is a bad sample."""
-    f = np.asarray(acc, dtype=float).reshape(-1)
-    if f.shape == (1,):
-        f = np.array([0.0, 0.0, f[0]])
-    elif f.shape != (3,):
-        f = np.full(3, math.nan)
+    the reason it is bad or None). ``acc`` is f_z or (3,) f_b; another shape is a bad sample.
+    A (3,) sequence or array whose values are finite and well inside the limits is checked on
+    Python floats and returned as a tuple of them (NaN fails every comparison, so it takes
+    the full check); anything else as an array, after the full check."""
     roll, pitch = float(roll), float(pitch)
+    if (type(acc) in (tuple, list) and len(acc) == 3) or (isinstance(acc, np.ndarray) and acc.shape == (3,)):
+        fx, fy, fz = float(acc[0]), float(acc[1]), float(acc[2])
+        if abs(roll) <= MAX_TILT and abs(pitch) <= MAX_TILT and fx * fx + fy * fy + fz * fz <= _FORCE_PASS2:
+            return (fx, fy, fz), roll, pitch, None
+        f = np.array((fx, fy, fz))
+    else:
+        f = np.asarray(acc, dtype=float).reshape(-1)
+        if f.shape == (1,):
+            f = np.array([0.0, 0.0, f[0]])
+        elif f.shape != (3,):
+            f = np.full(3, math.nan)
     return f, roll, pitch, _bad_sample(f, roll, pitch)
 
 
 def read_and_start(estimator: Any, acc: Any, roll: float, pitch: float,
-                   dt: float) -> tuple[np.ndarray, float, float, str | None]:
+                   dt: float) -> tuple[Any, float, float, str | None]:
     """:func:`read_sample`, and the start of a sample-by-sample heave filter (its ``dt``,
     ``reset()`` and ``start(dt)``, as :class:`~.highpass.HighpassHeave` and
     :class:`~.wiener.WienerHeave` have them): at the first step, or afresh when the step

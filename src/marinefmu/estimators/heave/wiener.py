@@ -477,17 +477,19 @@ class WienerHeave(WienerAxis):
     def reset(self) -> None:
         """Back to the initial state."""
         super().reset()
-        self.angle_buf = np.zeros((0, 2))    # ring of roll, pitch for the delayed point
+        self.angle_buf: list[tuple[float, float]] = []   # ring of (roll, pitch) for the delayed point
 
     def start(self, dt: float, first_design: float | None = None, interval: float | None = None) -> None:
         super().start(dt, first_design, interval)
-        self.angle_buf = np.zeros((self.lag_steps + 3, 2))
+        self.angle_buf = [(0.0, 0.0)] * (self.lag_steps + 3)
 
     def _angles(self, age: int, count: int) -> list[tuple[float, float]]:
         """``count`` (roll, pitch) samples [rad], oldest first, ending ``age`` samples before the
         newest stored one."""
-        n = len(self.angle_buf)
-        return [tuple(self.angle_buf[(self.k - 1 - age - j) % n]) for j in range(count - 1, -1, -1)]
+        buf = self.angle_buf
+        n = len(buf)
+        end = self.k - 1 - age
+        return [buf[(end - j) % n] for j in range(count - 1, -1, -1)]
 
     def step(self, acc: Any, roll: float, pitch: float, dt: float) -> HeaveResult:
         """Process one sample (arguments as :meth:`.OscillatorBankHeave.step`)."""
@@ -504,22 +506,22 @@ class WienerHeave(WienerAxis):
         if out is None:
             return HeaveResult(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, self.delay, 0.0, 0, 0.0, (), False, False,
                                warning)
-        heave, rate, d_heave, d_rate = out
+        heave, rate, d_heave, d_rate = out.tolist()
         rates = backward_rate(self._angles(0, min(3, self.k)), self.dt)
         ph, pr = point_heave(heave, rate, p.point, roll, pitch, *rates, p.transfer)
         old = self._angles(self.lag_steps, 3)
         d_point, _ = point_heave(d_heave, d_rate, p.point, *old[-1], *backward_rate(old, self.dt), p.transfer)
         delayed_valid = self.k * self.dt >= p.window + self.delay
-        return HeaveResult(float(heave), float(rate), ph, pr, float(d_heave), float(d_rate), d_point, self.delay,
+        return HeaveResult(heave, rate, ph, pr, d_heave, d_rate, d_point, self.delay,
                            self.level + self.mean, len(self.peaks), self.peak_period, self.peaks, warning is None,
                            delayed_valid, warning)
 
     def get_state(self) -> dict:
         """JSON-serialisable state."""
-        return {**super().get_state(), "angle_buf": np.asarray(self.angle_buf).tolist()}
+        return {**super().get_state(), "angle_buf": [list(a) for a in self.angle_buf]}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
         super().set_state(s)
         if s["dt"] is not None:
-            self.angle_buf = np.array(s["angle_buf"], dtype=float).reshape(-1, 2)
+            self.angle_buf = [(float(r), float(p)) for r, p in s["angle_buf"]]
