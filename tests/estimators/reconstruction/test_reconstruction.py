@@ -5,9 +5,10 @@ import math
 
 import numpy as np
 import pytest
+from scipy import linalg
 
 from marinefmu.errors import ParameterError
-from marinefmu.estimators.reconstruction.decomposition import (_complex_least_squares, _least_squares_amplitudes, decompose,
+from marinefmu.estimators.reconstruction.decomposition import (_complex_least_squares, _least_squares_amplitudes, _lstsq, decompose,
                                                  exp_grid, reconstruct_displacement, tilt_correct)
 from marinefmu.estimators.reconstruction.sliding import DisplacementReconstructorParams, DisplacementReconstructor
 from marinefmu.papers import paper000_sdof, paper000_semisub
@@ -53,6 +54,28 @@ def test_real_least_squares_equals_the_complex_solve():
     np.testing.assert_allclose(g_real, g_cplx, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(fit_real, fit_cplx, atol=1e-10)
     np.testing.assert_allclose(g_real[0], np.conj(g_real[1]), rtol=0, atol=0)  # exact pairs
+
+
+def test_least_squares_solver_equals_the_svd_solve():
+    """The amplitudes' solver (normal equations refined once, QR or SVD fallbacks) equals the
+    SVD-based minimum-norm solve to rounding on a well-conditioned basis, a near-degenerate one
+    (two poles 1e-7 rad/s apart: the fallback) and a complex one."""
+    rng = np.random.default_rng(7)
+    t = np.arange(1000) * 0.2
+    for gap in (0.3, 1e-7):
+        w = np.array([0.5, 0.5 + gap, 1.1, 2.0])
+        v = np.column_stack([np.cos(w * tt) for tt in t]).T
+        v = np.column_stack((v, np.sin(np.outer(t, w)), np.exp(-0.01 * t)))
+        v /= np.linalg.norm(v, axis=0)
+        x = v @ rng.normal(size=v.shape[1]) + 1e-3 * rng.normal(size=len(t))
+        ref, *_ = linalg.lstsq(v, x, lapack_driver="gelsd")
+        np.testing.assert_allclose(_lstsq(v, x) @ v.T, ref @ v.T, rtol=0, atol=1e-12)  # the fits
+        if gap > 1e-3:
+            np.testing.assert_allclose(_lstsq(v, x), ref, rtol=1e-12, atol=1e-13)
+    vc = np.exp(np.outer(t, [-0.01 + 1j, -0.02 + 0.4j]))
+    vc /= np.linalg.norm(vc, axis=0)
+    xc = (vc @ np.array([1.0 + 2j, -0.5j])).astype(complex)
+    np.testing.assert_allclose(_lstsq(vc, xc), linalg.lstsq(vc, xc)[0], rtol=1e-12)
 
 
 def test_sdof_example_of_section_4():
