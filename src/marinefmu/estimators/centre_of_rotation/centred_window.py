@@ -16,8 +16,15 @@ The filter weights come from :func:`scipy.signal.savgol_coeffs` (least-squares p
 order ``polyorder`` over the window, evaluated at its centre). :func:`derivative_noise_gain` and
 :func:`derivative_gain_error` give the two sides of choosing its length: the white noise a
 derivative passes, and the part of a sinusoid's derivative it loses.
+
+Cost per push: the write of one sample and one (2, n) × (n, channels) product giving the
+smoothed value and the derivative together. The weights are computed once per (window length,
+order, step) and kept (:func:`_savgol_weights`), so a resize and the kernels below do not fit
+them again: the same numbers, computed once.
 """
 from __future__ import annotations
+
+from functools import lru_cache
 
 import numpy as np
 from scipy.signal import savgol_coeffs
@@ -26,6 +33,15 @@ from ...errors import check_int, check_range
 
 #: Fewest samples in a window (a quadratic fit over 5 points still averages noise).
 MIN_SAMPLES = 5
+
+
+@lru_cache(maxsize=256)
+def _savgol_weights(n: int, polyorder: int, deriv: int, dt: float) -> np.ndarray:
+    """``savgol_coeffs(n, polyorder, deriv, delta=dt, use="dot")``, read-only, computed once per
+    argument set (the window sizing asks for the same windows every time it runs)."""
+    w = savgol_coeffs(n, polyorder, deriv=deriv, delta=dt, use="dot")
+    w.flags.writeable = False
+    return w
 
 
 def window_samples(window: float, dt: float, polyorder: int = 2) -> int:
@@ -40,7 +56,7 @@ def derivative_noise_gain(n: int, dt: float, polyorder: int) -> float:
     """Σ d_k² [1/s²] of the Savitzky–Golay derivative weights d over ``n`` samples of ``dt`` [s]:
     white noise of variance σ² per sample comes out of the derivative with variance σ² Σ d_k²
     (a gyro of white-noise density N [rad/s/√Hz] sampled at dt has σ² = N²/dt)."""
-    d = savgol_coeffs(n, polyorder, deriv=1, delta=dt, use="dot")
+    d = _savgol_weights(n, polyorder, 1, dt)
     return float(d @ d)
 
 
@@ -49,7 +65,7 @@ def derivative_increment_gain(n: int, dt: float, polyorder: int) -> float:
     of variance σ² per sample gives the step-to-step change of the derivative the variance
     σ² Σ (Δd)². Dominated by the window's ends, where the weights jump to and from zero
     (they fall as 1/n² against Σ d² as 1/n³, so the change of the noise falls as n⁻⁴)."""
-    d = savgol_coeffs(n, polyorder, deriv=1, delta=dt, use="dot")
+    d = _savgol_weights(n, polyorder, 1, dt)
     dd = np.diff(np.concatenate(([0.0], d, [0.0])))
     return float(dd @ dd)
 
@@ -62,7 +78,7 @@ def derivative_gain_error(n: int, dt: float, polyorder: int, omega: float) -> fl
     0.16 % at 0.2 Hz, 0.76 % at 0.3 Hz; over 3 s: 2.3 % at 0.2 Hz); 0 for ω = 0."""
     if omega <= 0.0:
         return 0.0
-    d = savgol_coeffs(n, polyorder, deriv=1, delta=dt, use="dot")
+    d = _savgol_weights(n, polyorder, 1, dt)
     t = (np.arange(n) - n // 2) * dt
     return float(1.0 - abs(d @ np.sin(omega * t)) / omega)
 
@@ -117,8 +133,10 @@ class CentredWindow:
         check_int("polyorder", self.polyorder, lo=0, hi=n - 2)
         self.n = n
         # use="dot": weights for the oldest..newest sample, evaluated at the centre (pos = n // 2)
-        self._smooth = savgol_coeffs(n, self.polyorder, deriv=0, use="dot")
-        self._deriv = savgol_coeffs(n, self.polyorder, deriv=1, delta=self.dt, use="dot")
+        self._smooth = _savgol_weights(n, self.polyorder, 0, 1.0)
+        self._deriv = _savgol_weights(n, self.polyorder, 1, self.dt)
+        # both weight rows in one (2, n) matrix: one product per push gives both fits
+        self._weights = np.vstack((self._smooth, self._deriv))
 
     @property
     def delay(self) -> float:
@@ -133,14 +151,18 @@ class CentredWindow:
     def push(self, sample: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """Add the newest sample; return (centre sample, smoothed, derivative [unit/s]) at the
         window centre, or None while the window is filling."""
-        c = self.capacity
+        c, ring = self.capacity, self._ring
         h = self._head = (self._head + 1) % c
-        self._ring[h] = self._ring[h + c] = sample
+        row = ring[h]
+        row[:] = sample
+        ring[h + c] = row
         self.count += 1
-        if self.count < self.n:
+        n = self.n
+        if self.count < n:
             return None
-        seg = self._ring[h + c + 1 - self.n:h + c + 1]
-        return seg[self.n // 2].copy(), self._smooth @ seg, self._deriv @ seg
+        seg = ring[h + c + 1 - n:h + c + 1]
+        fits = np.dot(self._weights, seg)
+        return seg[n // 2].copy(), fits[0], fits[1]
 
     @property
     def buffer(self) -> np.ndarray:

@@ -26,7 +26,7 @@ Two differences, each selectable:
 random walk (F = I, eq. 1) with process-noise densities ``acc_rw`` and ``offset_rw``;
 measurement z = f_b + R_nbᵀ g_n = H s with the time-varying H = [R_nbᵀ, −M(ω, α)],
 M = [α×] + [ω×]² (eq. 11); Joseph-form covariance update (eq. 5): :func:`joseph_update`, the
-operations of filterpy's ``KalmanFilter.update`` in the same order (a test checks the two agree).
+operations of filterpy's ``KalmanFilter.update`` (a test checks the two agree).
 The offset is identifiable only statistically: the filter finds the point whose acceleration
 is uncorrelated with α. Over a finite record the CR's acceleration and the rotation have a
 non-zero sample correlation, so even with exact data the estimate scatters about the true CR by
@@ -90,8 +90,10 @@ the CR would read (acc_cr, body) and the CR's acceleration (NED).
 rotation and H written out in floats, the prediction P + Q (F = I, so no products) and the
 Joseph-form update (H changes with every sample, so the covariance has no steady state and is
 updated every step); the sample checks, the angle integrator, the running statistics and the
-outputs work on plain floats. The window sizing runs every :data:`SIZING_EVERY` s. Nothing is
-approximated: the float forms are the same expressions as the array forms they stand for.
+outputs work on plain floats. The window sizing runs every :data:`SIZING_EVERY` s on the
+Savitzky–Golay weights computed once per window length (:mod:`.centred_window`). Nothing is
+approximated: the float forms are the same expressions as the array forms they stand for, and
+the 3 × 3 inverse of the update is written out (:func:`inv3`), equal to rounding.
 
 Not from a library: the Savitzky–Golay weights are scipy's; the update is filterpy's
 ``KalmanFilter.update`` in the same operations; only the measurement matrix and the leaky angle
@@ -353,6 +355,19 @@ def leaky_angle_step(euler: list[float], rate: list[float], dt: float, cutoff: f
 _EYE6 = np.eye(6)
 
 
+def inv3(m: np.ndarray, diag: float = 0.0) -> np.ndarray:
+    """Inverse of the (3, 3) matrix ``m`` + ``diag`` · I by its adjugate over its determinant
+    (for the innovation covariance H P Hᵀ + R, symmetric positive definite; ``numpy.linalg.inv``
+    costs several times more in call overhead at this size)."""
+    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
+    a, e, i = a + diag, e + diag, i + diag
+    c0, c1, c2 = e * i - f * h, f * g - d * i, d * h - e * g
+    r = 1.0 / (a * c0 + b * c1 + c * c2)
+    return np.array(((c0 * r, (c * h - b * i) * r, (b * f - c * e) * r),
+                     (c1 * r, (a * i - c * g) * r, (c * d - a * f) * r),
+                     (c2 * r, (b * g - a * h) * r, (a * e - b * d) * r)))
+
+
 def joseph_update(x: np.ndarray, P: np.ndarray, H: np.ndarray, z: np.ndarray,
                   r_var: float) -> tuple[np.ndarray, np.ndarray]:
     r"""Kalman measurement update with the Joseph-form covariance (paper 002, eq. 5) for the
@@ -363,7 +378,9 @@ def joseph_update(x: np.ndarray, P: np.ndarray, H: np.ndarray, z: np.ndarray,
         P^+ = (I - K H) P (I - K H)^T + K R K^T
 
     The operations of filterpy's ``KalmanFilter.update`` in the same order and shapes, without
-    its bookkeeping copies (the adds of R's zeros are left out: they change nothing).
+    its bookkeeping copies (the adds of R's zeros are left out: they change nothing), and with
+    the 3 × 3 inverse written out (:func:`inv3`; ``numpy.linalg.inv`` for other sizes): the same
+    result to rounding.
 
     Parameters
     ----------
@@ -386,8 +403,12 @@ def joseph_update(x: np.ndarray, P: np.ndarray, H: np.ndarray, z: np.ndarray,
     y = z - np.dot(H, x)
     pht = np.dot(P, H.T)
     s = np.dot(H, pht)
-    s.flat[::s.shape[0] + 1] += r_var
-    k = np.dot(pht, np.linalg.inv(s))
+    if s.shape == (3, 3):
+        si = inv3(s, r_var)
+    else:
+        s.flat[::s.shape[0] + 1] += r_var
+        si = np.linalg.inv(s)
+    k = np.dot(pht, si)
     x = x + np.dot(k, y)
     ikh = (_EYE6 if P.shape[0] == 6 else np.eye(P.shape[0])) - np.dot(k, H)
     return x, np.dot(np.dot(ikh, P), ikh.T) + np.dot(k * r_var, k.T)
