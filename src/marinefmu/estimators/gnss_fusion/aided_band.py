@@ -85,6 +85,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from filterpy.common import Q_continuous_white_noise
+from scipy.linalg.blas import dgemm
 
 from ..heave.oscillator_bank import BankModel, carry_map
 
@@ -152,6 +153,20 @@ def blocks_times(blocks: np.ndarray, m: np.ndarray) -> np.ndarray:
     (k·s, c) ``m``, element by element (:meth:`AidedBand._predict`)."""
     k, s, _ = blocks.shape
     return np.matmul(blocks, m.reshape(k, s, -1)).reshape(k * s, -1)
+
+
+def rank_one_down(m: np.ndarray, a: np.ndarray, b: np.ndarray) -> None:
+    """m ← m − a bᵀ in place, ``m`` a C-ordered block of rows.
+
+    BLAS dgemm of inner dimension one on the Fortran view mᵀ (one pass, no temporary), not
+    dger: OpenBLAS runs a rank-one update of some 170² on two threads, milliseconds a call
+    when the other core is busy, where its gemm stays on one thread below 65536·4 products."""
+    if m.size == 0:
+        return
+    if not m.flags.c_contiguous:            # dgemm would work on a copy
+        m -= np.outer(a, b)
+        return
+    dgemm(-1.0, b[:, None], a[None, :], beta=1.0, c=m.T, overwrite_c=True)
 
 
 class AidedBand:
@@ -380,9 +395,7 @@ class AidedBand:
         self.x = self.x + k * (z - float(h @ self.x))
         if not self.P.flags.c_contiguous:
             self.P = np.ascontiguousarray(self.P)
-        # P ← P − k phᵀ in place (numpy's outer product, not BLAS dger: OpenBLAS runs a rank-one
-        # update of this size on two threads, which costs milliseconds when the other core is busy)
-        np.subtract(self.P, np.multiply.outer(k, ph, out=self._scratch()), out=self.P)
+        rank_one_down(self.P, k, ph)
 
     def _block_segments(self) -> list[tuple[int, int, np.ndarray]] | None:
         """The block-diagonal part D = F + J Cᵀ of the transition (:meth:`_predict`) as
@@ -454,10 +467,10 @@ class AidedBand:
         self._block_times(pm, a)                            # D P
         np.copyto(pm, a.T)                                  # (D P)ᵀ (P is not needed again)
         self._block_times(pm, a)                            # D P Dᵀ = D (D P)ᵀ
-        # a ← a − 2 v Jᵀ in place (the rows where J is not zero), whose symmetric part is the
+        # a ← a − 2 J vᵀ in place (the rows where J is not zero), whose symmetric part is the
         # rank-two term
         j = self._j_rows
-        a[:j] -= np.multiply.outer(2.0 * self.J[:j], v)
+        rank_one_down(a[:j], 2.0 * self.J[:j], v)
         np.add(a, a.T, out=pm)
         pm *= 0.5
         pm += self.Q
