@@ -69,3 +69,14 @@ def test_the_speed_table_splits_each_base_step_into_components_and_the_rest():
                      "floor_over": {e: 150.0 / speed[e]["rtf"] for e in ("fmpy", "python", "libcosim")}})
     assert "| FMPy runner (FMI) | 60.0 s | 10.0 | 15.0 | 180 MB |" in text
     assert "| master and calls | 180 | 300 | 1.67 |" in text
+
+
+def test_the_component_budget_is_the_goals_step_less_the_floors():
+    """RTF 50 at a 10 ms step is 200 µs a base step; a floor of 153 (65.4 µs) leaves 134.6 µs
+    for the components; a floor below the goal leaves nothing."""
+    from marinefmu.bench.system import component_budget_us
+
+    assert component_budget_us(50.0, 153.0) == pytest.approx(200.0 - 1e4 / 153.0)
+    assert component_budget_us(50.0, 40.0) < 0
+    with pytest.raises(ValueError, match="rtf_goal"):
+        component_budget_us(0.0, 153.0)

@@ -201,6 +201,16 @@ def master_floor(fmu_dir: Path, work: Path, duration: float = 600.0) -> dict:
 SPEED_GOALS = {"rtf_fmpy": 50.0, "rtf_libcosim": 25.0, "fmi_over_in_process": 1.1, "peak_rss_mb_3h": 500.0}
 
 
+def component_budget_us(rtf_goal: float, floor_rtf: float, step: float = 0.01) -> float:
+    """What the components of a system may spend together per base step [µs] for a real-time
+    factor ``rtf_goal``, when the master and FMI alone (do-nothing FMUs, :func:`master_floor`)
+    run at ``floor_rtf``: 1e6 · step · (1/rtf_goal − 1/floor_rtf). Zero or less: the goal is out
+    of reach whatever the components do."""
+    if rtf_goal <= 0 or floor_rtf <= 0 or step <= 0:
+        raise ValueError(f"rtf_goal, floor_rtf and step must be > 0, got {rtf_goal}, {floor_rtf}, {step}")
+    return 1e6 * step * (1.0 / rtf_goal - 1.0 / floor_rtf)
+
+
 def speed_table(speed: dict) -> list[dict]:
     """Rows of the speed table from :func:`whole_system`'s ``speed`` entry: per component, its
     mean wall time per base step in ``doStep`` [µs] in-process (``python``) and through FMI
@@ -260,6 +270,11 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
     for row in result["table"]:
         print(f"  {row['component']:18s} {row['in_process_us']:7.0f} {row['fmi_us']:7.0f} "
               f"{row['fmi_over_in_process']:6.2f}", flush=True)
+    budget = component_budget_us(goals["rtf_fmpy"], speed["idle_fmus"]["rtf"], _system(None, None).step)
+    spent = sum(speed["fmpy"]["step_us"].values())
+    result["component_budget_us"] = {"budget": budget, "spent": spent}
+    print(f"for a real-time factor of {goals['rtf_fmpy']:g} under the FMPy runner the components may spend "
+          f"{budget:.0f} µs per base step together beside the floor; they spend {spent:.0f} µs", flush=True)
     result["first_second"] = first_second(fmu_dir, work)
     print(f"first second under the FMPy runner: {result['first_second']['wall_s']:.2f} s from loading the FMUs, "
           f"{result['first_second']['process_s']:.2f} s for the whole process", flush=True)
