@@ -200,15 +200,17 @@ def quat_from_rotvec(v: np.ndarray) -> np.ndarray:
     full precision.
     """
     vx, vy, vz = v
-    a2 = vx * vx + vy * vy + vz * vz
-    if a2 < 1e-8:
-        s = 0.5 - a2 / 48.0
-        c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0
-    else:
-        a = math.sqrt(a2)
-        s = math.sin(0.5 * a) / a
-        c = math.cos(0.5 * a)
+    s, c = half_angle_coefficients(vx * vx + vy * vy + vz * vz)
     return np.array([c, s * vx, s * vy, s * vz])
+
+
+def half_angle_coefficients(a2: float) -> tuple[float, float]:
+    """(sin(|v|/2)/|v|, cos(|v|/2)) from a2 = |v|² [rad²], the coefficients of the unit
+    quaternion of a rotation vector v; their Taylor series below |v| = 1e-4 rad."""
+    if a2 < 1e-8:
+        return 0.5 - a2 / 48.0, 1.0 - a2 / 8.0 + a2 * a2 / 384.0
+    a = math.sqrt(a2)
+    return math.sin(0.5 * a) / a, math.cos(0.5 * a)
 
 
 def quat_to_rot(q: np.ndarray) -> np.ndarray:

@@ -94,7 +94,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import check_choice, check_int, check_range, check_vector
-from ...frames import euler_to_quat, level_angles, quat_mul, quat_to_euler
+from ...frames import euler_to_quat, half_angle_coefficients, level_angles, quat_mul, quat_to_euler
 from ..noise_meter import WhiteNoiseMeter
 from ..samples import MAX_RATE, MAX_SPECIFIC_FORCE, force_beyond_limit, rate_beyond_limit
 
@@ -222,14 +222,7 @@ def _quat_step(qw: float, qx: float, qy: float, qz: float, vx: float, vy: float,
     """q ⊗ exp(½ v) for the rotation vector v [rad], normalised, on Python floats: the kernel of
     :func:`integrate_gyro` (:func:`~marinefmu.frames.quat_from_rotvec` and
     :func:`~marinefmu.frames.quat_mul` written out, term for term)."""
-    a2 = vx * vx + vy * vy + vz * vz
-    if a2 < 1e-8:
-        s = 0.5 - a2 / 48.0
-        c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0
-    else:
-        a = math.sqrt(a2)
-        s = math.sin(0.5 * a) / a
-        c = math.cos(0.5 * a)
+    s, c = half_angle_coefficients(vx * vx + vy * vy + vz * vz)
     rx, ry, rz = s * vx, s * vy, s * vz
     w = qw * c - qx * rx - qy * ry - qz * rz
     x = qw * rx + qx * c + qy * rz - qz * ry
