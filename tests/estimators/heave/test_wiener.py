@@ -171,3 +171,47 @@ def test_bias_step_search_is_the_least_squares_hinge_fit():
     assert find_bias_step(young[:int(602.5 / dt)], dt) is None                  # 2.5 s old
     old = find_bias_step(young[int(12.5 / dt):int(612.5 / dt)], dt)             # 12.5 s old
     assert old.index * dt + 12.5 == pytest.approx(600.0, abs=1.0) and old.size == pytest.approx(0.5, abs=0.05)
+
+
+def test_a_group_of_axes_gives_each_axis_own_outputs():
+    """WienerGroup's one batched product equals each axis's own push to rounding, through
+    designs a quarter interval apart (taps of different lengths, zero-padded), a bias step of 0.5 m/s²
+    taken out of one axis's buffers, bad samples, and a state restore (which rebinds)."""
+    from marinefmu.estimators.heave.common import SilentLog
+    from marinefmu.estimators.heave.wiener import WienerAxis, WienerGroup
+
+    p = HeaveObserverParams(window=120.0, peak_interval=15.0)
+    rng = np.random.default_rng(11)
+    n, dt = 30000, 0.01
+    t = np.arange(n) * dt
+    acc = np.stack([np.sin(w * t + ph) * a for w, ph, a in ((0.7, 0.1, 0.8), (0.9, 1.0, 0.5), (1.1, 2.0, 1.0))])
+    acc += 0.02 * rng.normal(size=acc.shape)
+    acc[2, 20000:] += 0.5                                    # a bias step on the third axis
+
+    def axes():
+        made = [WienerAxis(p, SilentLog(), f"axis {i}", reject_below=i < 2, find_steps=i == 2) for i in range(3)]
+        for i, axis in enumerate(made):
+            axis.start(dt, p.window + p.peak_interval * i / 4.0, interval=4 * p.peak_interval)
+        return made
+
+    single, grouped = axes(), axes()
+    group = WienerGroup(grouped)
+    group.bind()
+    seen = 0
+    for k in range(n):
+        values = [None if k in (16000, 16001) else float(acc[i, k]) for i in range(3)]
+        if k == 25000:
+            restored = axes()
+            for axis, old in zip(restored, grouped):
+                axis.set_state(old.get_state())
+            group = WienerGroup(restored)
+            group.bind()
+            grouped = restored
+        out = group.push(values)
+        own = [axis.push(v) for axis, v in zip(single, values)]
+        if any(o is None for o in own):
+            assert out is None
+            continue
+        seen += 1
+        np.testing.assert_allclose(out, np.array(own), rtol=0, atol=1e-12)
+    assert seen > 15000 and single[2].level != 0.0

@@ -157,16 +157,17 @@ def test_a_step_size_change_restarts_with_a_warning(short):
 
 
 def test_the_level_rotation_and_the_scalar_low_pass_are_the_general_ones_written_out():
-    """``level_rotation`` is Rz(ψ̄)ᵀ R_nb (to rounding), and ``push_float`` the vector low-pass
+    """``level_rows`` is Rz(ψ̄)ᵀ R_nb(q) (to rounding), and ``push_float`` the vector low-pass
     on one number bit for bit, its state in the vector's format."""
     import math
 
-    from marinefmu.estimators.mru.level_frame import SlowLowPass, level_rotation, yaw_rotation
-    from marinefmu.frames import rot_nb
+    from marinefmu.estimators.mru.level_frame import SlowLowPass, level_rows, yaw_rotation
+    from marinefmu.frames import euler_to_quat, quat_to_rot
 
     for yaw_ref, angles in ((0.3, (0.05, -0.02, 1.1)), (-2.9, (0.2, 0.1, -3.0)), (math.pi, (0.0, 0.0, 0.0))):
-        r = rot_nb(*angles)
-        np.testing.assert_allclose(level_rotation(yaw_ref, r), yaw_rotation(yaw_ref) @ r, rtol=0, atol=1e-15)
+        q = euler_to_quat(*angles)
+        np.testing.assert_allclose(np.reshape(level_rows(yaw_ref, tuple(q)), (3, 3)),
+                                   yaw_rotation(yaw_ref) @ quat_to_rot(q), rtol=0, atol=1e-15)
     rng = np.random.default_rng(4)
     x = rng.normal(size=500)
     vector, scalar = SlowLowPass(30.0), SlowLowPass(30.0)

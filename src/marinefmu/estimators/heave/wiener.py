@@ -405,6 +405,14 @@ class WienerAxis:
         ``delay`` s ago, as a (4,) array; None before the first design. Every step: the ring
         writes and L + 1 reads of the running sum; every :data:`STEP_CHECK` s the bias-step
         search; every ``peak_interval`` the design."""
+        self.record(a)
+        if self.taps is None:
+            return None
+        return self.output()
+
+    def record(self, a: float | None) -> None:
+        """:meth:`push` without its outputs: the sample into the buffers, and the bias-step
+        search and the design when they are due."""
         a_v = self.mean if a is None else a - self.level
         self.spectrum_buf[self.k % len(self.spectrum_buf)] = a_v
         n_sum = self.n_fir + 1
@@ -416,9 +424,18 @@ class WienerAxis:
             self._check_bias_step()
         if self.k >= self.next_detect:
             self._design()
-        if self.taps is None:
-            return None
-        nodes = self.sum_buf[i + n_sum:i + n_sum - self.taps.shape[1] * self.block - 1:-self.block]
+
+    def nodes(self, buf: np.ndarray, blocks: int) -> np.ndarray:
+        """The running sums at the newest sample and every block before it, ``blocks`` + 1 of
+        them, newest first, from ``buf`` (this axis's ``sum_buf``, or a stack of such buffers
+        along the last axis); a block's sum is the difference of two neighbours."""
+        n_sum = self.n_fir + 1
+        i = (self.k - 1) % n_sum + n_sum
+        return buf[..., i:i - blocks * self.block - 1:-self.block]
+
+    def output(self) -> np.ndarray:
+        """Step 3's outputs of the current filter after :meth:`record` (as :meth:`push`)."""
+        nodes = self.nodes(self.sum_buf, self.taps.shape[1])
         return self.taps @ (nodes[:-1] - nodes[1:]) - self.mean * self.tap_sums
 
     def get_state(self) -> dict:
@@ -446,6 +463,66 @@ class WienerAxis:
         self.step_at = None if s["step_at"] is None else int(s["step_at"])
         self.peaks = tuple(float(w) for w in s["peaks"])
         self.no_sea = bool(s["no_sea"])
+
+
+class WienerGroup:
+    """Several :class:`WienerAxis` filters stepped together, their outputs by one product.
+
+    Each axis keeps its own buffers, spectrum, design and bias-step search; the group only moves
+    their running sums into the rows of one array (each axis's ``sum_buf`` a view of its row,
+    so the axes' own in-place updates land there) and holds their taps zero-padded to the
+    longest memory, so that step 3 of all of them is one batched (A × 4 × L)·(A × L) product
+    instead of one product and a dozen small numpy calls per axis. The outputs equal each
+    axis's :meth:`WienerAxis.push` to rounding (the sums are formed in another order; the
+    padding multiplies finite sums by zero).
+
+    Parameters
+    ----------
+    axes : sequence of WienerAxis
+        Filters with the same step and memory (the same ``dt``, ``block`` and ``blocks``),
+        pushed every step. Call :meth:`bind` after their ``start`` or ``set_state``, which
+        give them new buffers.
+    """
+
+    def __init__(self, axes: list[WienerAxis]) -> None:
+        self.axes = list(axes)
+        self.sums = np.zeros((len(self.axes), 0))
+        self._designs: list[np.ndarray | None] = []       # the taps the stack below was built from
+        self._taps = np.zeros((len(self.axes), 4, 0))
+        self._offsets = np.zeros((len(self.axes), 4))     # mean × the taps' sums, per axis
+
+    def bind(self) -> None:
+        """Move the axes' running sums into one array (after their ``start`` or ``set_state``)."""
+        first = self.axes[0]
+        if any(a.dt != first.dt or a.block != first.block or a.blocks != first.blocks for a in self.axes):
+            raise ValueError("WienerGroup: the axes must share dt, block and blocks")
+        self.sums = np.stack([a.sum_buf for a in self.axes])
+        for row, axis in zip(self.sums, self.axes):
+            axis.sum_buf = row
+        self._designs = []
+
+    def push(self, values: list[float | None]) -> np.ndarray | None:
+        """One sample per axis (as :meth:`WienerAxis.push`): the (A, 4) outputs, a row per axis,
+        or None while any axis has no design yet."""
+        axes = self.axes
+        for axis, a in zip(axes, values):
+            axis.record(a)
+        if len(self._designs) != len(axes) or any(a.taps is not t for a, t in zip(axes, self._designs)):
+            if any(a.taps is None for a in axes):
+                return None
+            self._stack_taps()
+        nodes = axes[0].nodes(self.sums, self._taps.shape[2])
+        blocks = nodes[:, :-1] - nodes[:, 1:]
+        return np.matmul(self._taps, blocks[:, :, None])[:, :, 0] - self._offsets
+
+    def _stack_taps(self) -> None:
+        """The axes' current taps, zero-padded to the longest, and their mean terms."""
+        longest = max(a.taps.shape[1] for a in self.axes)
+        self._taps = np.zeros((len(self.axes), 4, longest))
+        for row, axis in zip(self._taps, self.axes):
+            row[:, :axis.taps.shape[1]] = axis.taps
+        self._offsets = np.array([a.mean * a.tap_sums for a in self.axes])
+        self._designs = [a.taps for a in self.axes]
 
 
 class WienerHeave(WienerAxis):

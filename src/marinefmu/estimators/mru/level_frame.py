@@ -22,6 +22,7 @@ while a wave (period ≥ 5 s) is a quartic over 1 s to within 0.3 % in ḋ.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from scipy.signal import savgol_coeffs
@@ -107,15 +108,19 @@ def yaw_rotation(yaw: float) -> np.ndarray:
     return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def level_rotation(yaw_ref: float, rot_nb: np.ndarray) -> np.ndarray:
-    """R_hb = Rz(ψ̄)ᵀ R_nb [3 × 3] (:func:`yaw_rotation` times ``rot_nb``), written out: its rows
-    are cos ψ̄ r₀ + sin ψ̄ r₁, cos ψ̄ r₁ − sin ψ̄ r₀ and r₂ of R_nb's rows r."""
+def level_rows(yaw_ref: float, q: Any) -> tuple[float, ...]:
+    """R_hb = Rz(ψ̄)ᵀ R_nb(q) (:func:`yaw_rotation` times :func:`~marinefmu.frames.quat_to_rot`),
+    its nine entries row by row on Python floats: R_nb's rows r from the unit quaternion
+    q = (w, x, y, z), then cos ψ̄ r₀ + sin ψ̄ r₁, cos ψ̄ r₁ − sin ψ̄ r₀ and r₂. Written out
+    because two 3 × 3 arrays a step cost more than the arithmetic."""
+    w, x, y, z = q
+    ww, xx, yy, zz = w * w, x * x, y * y, z * z
+    a0, a1, a2 = ww + xx - yy - zz, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
+    b0, b1, b2 = 2.0 * (x * y + w * z), ww - xx + yy - zz, 2.0 * (y * z - w * x)
     c, s = math.cos(yaw_ref), math.sin(yaw_ref)
-    out = np.empty((3, 3))
-    np.add(c * rot_nb[0], s * rot_nb[1], out=out[0])
-    np.subtract(c * rot_nb[1], s * rot_nb[0], out=out[1])
-    out[2] = rot_nb[2]
-    return out
+    return (c * a0 + s * b0, c * a1 + s * b1, c * a2 + s * b2,
+            c * b0 - s * a0, c * b1 - s * a1, c * b2 - s * a2,
+            2.0 * (x * z - w * y), 2.0 * (y * z + w * x), ww - xx - yy + zz)
 
 
 def unwrap(previous: float, yaw: float) -> float:

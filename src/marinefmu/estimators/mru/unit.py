@@ -56,12 +56,12 @@ from typing import Any
 
 import numpy as np
 
-from ...frames import G, quat_to_rot, rot_nb
+from ...frames import G, rot_nb
 from ..attitude.estimator import AttitudeEstimator, AttitudeResult
 from ..heave.common import HeaveObserverParams, SilentLog
-from ..heave.wiener import WienerAxis
+from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW
-from .level_frame import SlowLowPass, derivative_weights, level_rotation, unwrap
+from .level_frame import SlowLowPass, derivative_weights, level_rows, unwrap
 from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
@@ -88,14 +88,6 @@ def euler_yaw_rate(gyro: Any, att: AttitudeResult) -> float:
     w_y = float(gyro[1]) - float(att.gyro_bias[1])
     w_z = float(gyro[2]) - float(att.gyro_bias[2])
     return (math.sin(att.roll) * w_y + math.cos(att.roll) * w_z) / math.cos(att.pitch)
-
-
-def _at_points(imu: np.ndarray, arms: np.ndarray) -> np.ndarray:
-    """(P + 1, 3): the IMU's row, then the IMU's plus each point's arm term."""
-    out = np.empty((len(arms) + 1, 3))
-    out[0] = imu
-    np.add(imu, arms, out=out[1:])
-    return out
 
 
 class MotionReferenceUnit:
@@ -129,13 +121,14 @@ class MotionReferenceUnit:
         self.axes = [WienerAxis(p.motion, self.log, f"mru {name}", reject_below=name != "heave",
                                 find_steps=name == "heave") for name in AXES]
         self.yaw_axis = WienerAxis(yaw_filter_params(p), self.log, "mru yaw", reject_below=True, find_steps=False)
+        self.group = WienerGroup([*self.axes, self.yaw_axis] if len(self.arms) else self.axes)
         self.yaw_ref = SlowLowPass(YAW_TAU)
         self.arm_mean = SlowLowPass(ARM_TAU, from_zero=True)
         self.dt: float | None = None
         self.k = 0
         self.yaw: float | None = None                 # the unwrapped gyro yaw [rad]
         self.heading_offset: float | None = None      # c of the heading aid [rad]
-        self.rot = np.eye(3)                          # R_hb of the last good sample
+        self.rot_rows = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)   # R_hb of the last good sample, row by row
         self.heave_acc = 0.0                          # the last good vertical acceleration [m/s²]
         self.arm_ring = np.zeros((0, len(self.arms), 3))
 
@@ -149,9 +142,15 @@ class MotionReferenceUnit:
                        interval=DESIGN_ROUNDS * m.peak_interval)
         self.weights = derivative_weights(dt)
         self.lag_steps = self.axes[0].lag_steps
-        self.arm_ring = np.zeros((max(self.lag_steps + 1, self.weights.shape[1]), len(self.arms), 3))
-        self._ring_offsets = {self.weights.shape[1]: np.arange(self.weights.shape[1])}
+        self.group.bind()
+        ring = max(self.lag_steps + 1, self.weights.shape[1])
+        self.arm_ring = np.zeros((2 * ring, len(self.arms), 3))    # each sample twice: the last W are one slice
         self.delayed_from = m.window + m.peak_interval * 3.0 / 4.0 + self.axes[0].delay
+
+    @property
+    def rot(self) -> np.ndarray:
+        """R_hb of the last good sample [3 × 3]."""
+        return np.array(self.rot_rows).reshape(3, 3)
 
     @property
     def delay(self) -> float:
@@ -187,55 +186,59 @@ class MotionReferenceUnit:
         a_h = None
         if good:
             self.yaw = att.yaw if self.yaw is None else unwrap(self.yaw, att.yaw)
-            self.rot = level_rotation(self.yaw_ref.push_float(self.yaw, dt), quat_to_rot(att.q))
-            a_h = self.rot @ np.asarray(acc, dtype=float)
-            a_h[2] += G
-        outs = [axis.push(None if a_h is None else float(a_h[i])) for i, axis in enumerate(self.axes)]
-        yaw_wave = None                                # the yaw filter serves the lever arms only
-        if len(self.arms):
-            yaw_wave = self.yaw_axis.push(euler_yaw_rate(gyro, att) if good else None)
-        n = len(self.arm_ring)
-        if good or self.k == 0:
-            rot = self.rot if yaw_wave is None else rot_nb(att.roll, att.pitch, float(yaw_wave[1]))
-            arm = self.arms @ rot.T - self.arms                              # (P, 3): R_hb r − r
-            self.arm_ring[self.k % n] = arm - self.arm_mean.push(arm, dt) if good else 0.0
-        else:
-            self.arm_ring[self.k % n] = self.arm_ring[(self.k - 1) % n]
+            r = self.rot_rows = level_rows(self.yaw_ref.push_float(self.yaw, dt), att.q)
+            f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
+            a_h = (r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2,
+                   r[6] * f0 + r[7] * f1 + r[8] * f2 + G)
+        points = len(self.arms)
+        values: list[float | None] = [None, None, None] if a_h is None else list(a_h)
+        if points:                                     # the yaw filter serves the lever arms only
+            values.append(euler_yaw_rate(gyro, att) if good else None)
+        out = self.group.push(values)                  # (axes, 4): position, rate, delayed position, rate
+        n = len(self.arm_ring) // 2
+        if points:
+            i = self.k % n
+            if good or self.k == 0:
+                if out is not None:
+                    yaw_wave = float(out[3, 1])
+                else:                                  # before the first designs (see the class docstring)
+                    yaw_wave = None if self.yaw_axis.taps is None else float(self.yaw_axis.output()[1])
+                rot = self.rot if yaw_wave is None else rot_nb(att.roll, att.pitch, yaw_wave)
+                arm = self.arms @ rot.T - self.arms                              # (P, 3): R_hb r − r
+                self.arm_ring[i] = self.arm_ring[i + n] = arm - self.arm_mean.push(arm, dt) if good else 0.0
+            else:
+                self.arm_ring[i] = self.arm_ring[i + n] = self.arm_ring[(self.k - 1) % n]
         self.k += 1
         heave_axis = self.axes[2]
         if a_h is not None:
-            self.heave_acc = float(a_h[2]) - heave_axis.level - heave_axis.mean
+            self.heave_acc = a_h[2] - heave_axis.level - heave_axis.mean
         yaw_out, heading_used, heading_warning = self._heading(att.yaw, heading, heading_valid, dt)
         warning = restart or att.warning or heading_warning
         angles_valid = att.valid and heading_warning is None
-        rows = len(self.arms) + 1
-        if outs[0] is None or outs[1] is None or outs[2] is None or (yaw_wave is None and len(self.arms)):
+        rows = points + 1
+        if out is None:
             zeros = np.zeros((rows, 3))
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros.copy(), np.zeros(rows), zeros.copy(),
                              self.delay, heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
-        o = np.array(outs).T                       # (4, 3 axes): position, rate, delayed position, ...
+        o = out[:3, :3].T                          # (3, 3 axes): position, rate, delayed position
         w = self.weights.shape[1]
+        j = (self.k - 1) % n                       # the newest sample's row
         if self.k >= w:
-            recent = self.arm_ring.take(self._ring_index(w, n), axis=0)      # (W, P, 3), oldest first
-            d_rate = (self.weights @ recent.reshape(w, -1)).reshape(2, len(self.arms), 3)
+            recent = self.arm_ring[j + n - w + 1:j + n + 1]                  # (W, P, 3), oldest first
+            d_rate = (self.weights @ recent.reshape(w, -1)).reshape(2, points, 3)
         else:
-            d_rate = np.zeros((2, len(self.arms), 3))
-        arm_now = self.arm_ring[(self.k - 1) % n]
-        arm_then = self.arm_ring[(self.k - 1 - self.lag_steps) % n]
-        position, velocity, delayed = (_at_points(o[i], arm) for i, arm in ((0, arm_now), (1, d_rate[0]), (2, arm_then)))
+            d_rate = np.zeros((2, points, 3))
+        motion = np.empty((3, rows, 3))            # position, velocity, delayed position: IMU, then points
+        motion[:, 0] = o
+        np.add(o[0], self.arm_ring[j], out=motion[0, 1:])
+        np.add(o[1], d_rate[0], out=motion[1, 1:])
+        np.add(o[2], self.arm_ring[(self.k - 1 - self.lag_steps) % n], out=motion[2, 1:])
         heave_acc = np.empty(rows)
         heave_acc[0] = self.heave_acc
         np.add(self.heave_acc, d_rate[1][:, 2], out=heave_acc[1:])
-        return MruResult(att.roll, att.pitch, yaw_out, position, velocity, heave_acc, delayed, self.delay,
+        return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], heave_acc, motion[2], self.delay,
                          heave_axis.peak_period, angles_valid, good, good and self.k * dt >= self.delayed_from,
                          heading_used, warning)
-
-    def _ring_index(self, w: int, n: int) -> np.ndarray:
-        """Indices into the arm ring of the last ``w`` of its ``n`` samples, oldest first."""
-        start = (self.k - w) % n
-        index = self._ring_offsets[w] + start
-        index[index >= n] -= n
-        return index
 
     def _heading(self, yaw: float, heading: float | None, heading_valid: bool,
                  dt: float) -> tuple[float, bool, str | None]:
@@ -275,9 +278,10 @@ class MotionReferenceUnit:
         for axis, st in zip(self.axes, s["axes"]):
             axis.set_state(st)
         self.yaw_axis.set_state(s["yaw_axis"])
+        self.group.bind()
         self.yaw_ref.set_state(s["yaw_ref"], scalar=True)
         self.arm_mean.set_state(s["arm_mean"])
         self.yaw, self.heading_offset = s["yaw"], s["heading_offset"]
-        self.rot = np.array(s["rot"], dtype=float)
+        self.rot_rows = tuple(float(v) for v in np.ravel(s["rot"]))
         self.heave_acc = float(s["heave_acc"])
         self.arm_ring = np.array(s["arm_ring"], dtype=float).reshape(s["arm_ring_shape"])
