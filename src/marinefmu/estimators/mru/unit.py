@@ -32,10 +32,12 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    (``heading_tau``; the first valid heading sets c). It does not enter the motion, which is
    in the level frame of the mean heading either way.
 
-What runs when: every step, the attitude, one 3 × 3 rotation, four FIR outputs of L + 1
-running-sum reads each, and the points' arms (one (2 × W)·(W × 3P) product for their rates and
-accelerations; the level frame's yaw reference and rows on Python floats, no array per
-scalar); every second, each filter's bias-step search;
+What runs when: every step, the attitude, the level frame's rows and a_h on Python floats
+(:func:`~.level_frame.level_rows`), each filter's ring writes and the four filters' outputs
+as one batched product (:class:`~marinefmu.estimators.heave.wiener.WienerGroup`), and the
+points' arms (one rotation, one low-pass, one (2 × W)·(W × 3P) product on a contiguous slice of
+the arm ring, stored twice for it, for their rates and accelerations); every second, the heave
+filter's bias-step search;
 first after ``motion.window`` s and then every :data:`DESIGN_ROUNDS` × ``motion.peak_interval``
 s, each filter's Wiener design, the four a quarter of an interval apart (on average one
 design per interval in all, as the HeaveObserver), so that no step designs more than one.
