@@ -203,7 +203,7 @@ class MotionReferenceUnit:
             if good or self.k == 0:
                 if out is not None:
                     yaw_wave = float(out[3, 1])
-                else:                                  # before the first designs (see the class docstring)
+                else:                                  # some filter not yet designed: the yaw one may be
                     yaw_wave = None if self.yaw_axis.taps is None else float(self.yaw_axis.output()[1])
                 rot = self.rot if yaw_wave is None else rot_nb(att.roll, att.pitch, yaw_wave)
                 arm = self.arms @ rot.T - self.arms                              # (P, 3): R_hb r − r
