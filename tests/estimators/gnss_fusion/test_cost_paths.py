@@ -57,7 +57,9 @@ def test_the_coasts_structured_filter_equals_the_dense_one(tilt_band):
     """F is checked block-diagonal but for the increment form's rank-one feed-through, and 400
     band steps of acceleration, wave-tilt and position updates through the structured prediction
     and the in-place update agree with the plain dense recursion (P ← F P Fᵀ + Q symmetrised,
-    P ← P − K phᵀ) to 1e-12 of the largest variance and state."""
+    P ← P − K phᵀ) to 1e-12 of the largest variance and 1e-11 of the largest state: the two
+    forms sum their products in other orders, and over 400 steps the state's rounding reached
+    1.4e-12 of it with OpenBLAS 0.3.31's Haswell kernels."""
     f = band_filter(tilt_band)
     assert f._segments is not None
     x, p = f.x.copy(), f.P.copy()
@@ -85,4 +87,4 @@ def test_the_coasts_structured_filter_equals_the_dense_one(tilt_band):
             h[f.n_band + f.n_extra:] = f.angle.heave_rows[0, :-1]
             x, p = update(x, p, h, 1e-3 * math.sin(0.6 * DT * k), 1e-3 ** 2)
     np.testing.assert_allclose(f.P, p, rtol=0, atol=1e-12 * np.max(np.diag(p)))
-    np.testing.assert_allclose(f.x, x, rtol=0, atol=1e-12 * np.max(np.abs(x)))
+    np.testing.assert_allclose(f.x, x, rtol=0, atol=1e-11 * np.max(np.abs(x)))

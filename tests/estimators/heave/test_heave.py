@@ -2,6 +2,7 @@
 against filterpy, the fixed-lag smoother against filterpy's RTS smoother, exact kernels
 against VesselMotion truth, accuracy against truth, the bias step, and bad input."""
 import functools
+import json
 import math
 
 import numpy as np
@@ -598,8 +599,10 @@ def test_highpass_baseline_has_the_analytic_response_and_refuses_a_bad_cutoff():
 def test_track_spectrum_builds_the_same_models_as_step():
     """An observer fed by ``track_spectrum`` once it has a model (what WaveCoast does: it runs
     the model in a filter of its own) buffers the same samples and rebuilds, every
-    ``peak_interval``, exactly the models that ``step`` would. Before the first model it
-    refuses, naming the method to call."""
+    ``peak_interval``, exactly the models that ``step`` would. Only the first model, which it
+    stepped, has had its Riccati equation solved; a later one solves it when its gain is asked
+    for, and then equals the stepped observer's. Before the first model it refuses, naming the
+    method to call."""
     dt, p = 0.05, HeaveObserverParams(model="band", window=60.0, peak_interval=15.0, smoother_lag=0.0)
     t = dt * np.arange(1, int(200 / dt) + 1)
     f_z = -G - 0.5 * np.sin(0.7 * t) - 0.3 * np.sin(1.3 * t + 1.0)
@@ -615,8 +618,32 @@ def test_track_spectrum_builds_the_same_models_as_step():
             lean.track_spectrum(f, 0.0, 0.0)
         if lean.model is not None and (not models or models[-1] is not lean.model):
             models.append(lean.model)
+            assert ("P" in vars(lean.model)) == (len(models) == 1)      # solved on first use only
             assert np.array_equal(full.model.omega, lean.model.omega)
             assert np.array_equal(full.model.Q, lean.model.Q)
             assert np.array_equal(full.model.K, lean.model.K)
     assert len(models) == 10                    # at 60 s, then every 15 s to 195 s
     assert np.array_equal(full.buf, lean.buf)
+
+
+def test_a_state_saved_right_after_a_new_model_restores_the_same_run():
+    """The smoother takes a new model at the next Kalman step (``_bind_smoother``); a state
+    saved between, right after a spectrum update, restores to a run whose outputs, delayed
+    ones included, equal the uninterrupted run's bit for bit."""
+    dt, p = 0.05, HeaveObserverParams(model="band", window=60.0, peak_interval=15.0, smoother_lag=2.0)
+    t = dt * np.arange(1, int(120 / dt) + 1)
+    f_z = -G - 0.5 * np.sin(0.7 * t) - 0.3 * np.sin(1.3 * t + 1.0)
+    run = OscillatorBankHeave(p, quiet=True)
+    models = []
+    for k, f in enumerate(f_z):
+        run.step(f, 0.0, 0.0, dt)
+        if run.model is not None and (not models or run.model is not models[-1]):
+            models.append(run.model)
+        if len(models) == 2:                   # the second model, at 75 s, made by this step
+            break
+    copy = OscillatorBankHeave(p, quiet=True)
+    copy.set_state(json.loads(json.dumps(run.get_state())))
+    for f in f_z[k + 1:]:
+        a, b = run.step(f, 0.0, 0.0, dt), copy.step(f, 0.0, 0.0, dt)
+        assert (a.heave, a.delayed_heave, a.delayed_valid) == (b.heave, b.delayed_heave, b.delayed_valid)
+    assert k + 1 == int(round(75.0 / dt)) and a.delayed_valid

@@ -307,7 +307,8 @@ class AidedBand:
         if band_state is not None:
             x[at:at + n] = np.asarray(band_state, dtype=float)[:n]
         fresh = np.flatnonzero(~t[at:at + n].any(axis=1))
-        restart(x, p, at + fresh, model.P[np.ix_(fresh, fresh)], x[at + fresh])
+        if len(fresh):                      # model.P is solved on first use (BankModel)
+            restart(x, p, at + fresh, model.P[np.ix_(fresh, fresh)], x[at + fresh])
         return x, p
 
     def weak_angle(self, variance: float) -> None:

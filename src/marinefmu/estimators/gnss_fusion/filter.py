@@ -97,11 +97,15 @@ north, east, down; the body frame x forward, y starboard, z down; g_n = [0, 0, +
 
 Cost per step: every sample, the gyro attitude's exact rotation, the attitude-corrected
 acceleration, the Kalman prediction and the output's position variance, and the wave coast's
-tracking (:mod:`.wave_coast`: its band filters run at every sample so that a dropout can be
-bridged at once; its covariance work is structured, :mod:`.aided_band`); at each accepted GNSS
-epoch, the antenna attitude (Wahba), the PI attitude correction and the Kalman update; every
-:data:`~.wave_coast.PEAK_INTERVAL` s, the coast's band model rebuilt. The fix-to-fix rotation vectors are
-written out in floats (:func:`~.antenna_attitude.matrix_rotvec`), equal to scipy's bit for bit.
+tracking (:mod:`.wave_coast`: block sums every sample, its band filters every band step of
+about 1/:data:`~.wave_coast.RATE` s, so that a dropout can be bridged at once; their covariance
+work is structured, :mod:`.aided_band`); at each accepted GNSS epoch, the antenna attitude
+(Wahba), the PI attitude correction and the Kalman update; every
+:data:`~.wave_coast.PEAK_INTERVAL` s, the coast's band models rebuilt from the spectra, whose
+steady-state Riccati solution is needed (and solved) only for an observer's first model and for
+elements new to a later one (:class:`~marinefmu.estimators.heave.oscillator_bank.BankModel`).
+The fix-to-fix rotation vectors are written out in floats
+(:func:`~.antenna_attitude.matrix_rotvec`), equal to scipy's bit for bit.
 """
 from __future__ import annotations
 

@@ -71,6 +71,7 @@ class OscillatorBankHeave:
         self.peak_period = 0.0
         self.no_sea = False                     # the last spectrum had no peak (logged once: module docstring)
         self.smoother: FixedLagOutputs | None = None
+        self._smoothed: BankModel | None = None    # the model the smoother was last set to
         self._delayed: tuple[np.ndarray, np.ndarray] | None = None
         self._aux = np.zeros(4)
         self._result = HeaveResult(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, (), False, False)
@@ -219,9 +220,20 @@ class OscillatorBankHeave:
         return True
 
     def _use(self, model: BankModel) -> None:
-        """Make ``model`` the observer's (the smoother freezes the pending times)."""
+        """Make ``model`` the observer's; the smoother takes it before the next Kalman step
+        (:meth:`_bind_smoother`)."""
         self.model = model
-        self.smoother.set_model(model.heave_rows, model.P, model.closed_loop, model.C, model.S)
+
+    def _bind_smoother(self) -> None:
+        """Give the smoother the current model, if it has not had it (it then freezes the
+        pending times). Deferred from :meth:`_use` to the next Kalman step, state save or
+        restore, with nothing between that reads the smoother, so the outputs are those of an
+        immediate set: an observer that only tracks the spectrum (:meth:`track_spectrum`) then
+        never needs its model's Riccati solution (:class:`.BankModel`)."""
+        if self._smoothed is not self.model:
+            m = self.model
+            self.smoother.set_model(m.heave_rows, m.P, m.closed_loop, m.C, m.S)
+            self._smoothed = m
 
     def response(self, omega: Any) -> np.ndarray | None:
         """Heave response H(ω) of the current model (:meth:`.BankModel.heave_response`): the
@@ -260,6 +272,7 @@ class OscillatorBankHeave:
         ``"increment"``: the measurement is the mean of the previous and this sample, the prior
         refers to the previous sample's time.
         """
+        self._bind_smoother()
         m, sm = self.model, self.smoother
         if m.measurement == "paper":
             y, state_aux = a_v, aux
@@ -309,6 +322,8 @@ class OscillatorBankHeave:
         """JSON-serialisable internal state (the bank is rebuilt from its frequencies)."""
         def arr(v: Any) -> Any:
             return None if v is None else np.asarray(v).tolist()
+        if self.model is not None:
+            self._bind_smoother()
         return {
             "dt": self.dt, "buf": arr(self.buf), "k": self.k, "next_detect": self.next_detect,
             "omega": None if self.model is None else self.model.omega.tolist(), "variance": arr(self._variance),
@@ -331,6 +346,7 @@ class OscillatorBankHeave:
         self._variance = None if s["variance"] is None else np.array(s["variance"], dtype=float)
         if s["omega"] is not None:
             self._use(self._build(np.array(s["omega"], dtype=float), self._variance))
+            self._bind_smoother()
         self.xp, self.x = np.array(s["xp"], dtype=float), np.array(s["x"], dtype=float)
         self.prev = None if s["prev"] is None else (s["prev"][0], np.array(s["prev"][1]))
         self.angles = [tuple(a) for a in s["angles"]]

@@ -112,11 +112,20 @@ class BankModel:
     R : float
         Variance of the measurement noise (the decorrelated model's) [(m/s²)²].
     K : numpy.ndarray
-        (n,) steady-state update gain.
+        (n,) steady-state update gain P Cᵀ / S.
     P : numpy.ndarray
         (n, n) steady-state prior covariance.
     S : float
         Innovation variance C P Cᵀ + R.
+
+    Notes
+    -----
+    K, P and S come from the discrete algebraic Riccati equation of (Ā, Q, C, R) (python-control
+    ``dlqe``), solved on first use and kept. An estimator that runs the model in a Kalman filter
+    of its own and only tracks the spectrum with the observer
+    (:class:`~marinefmu.estimators.gnss_fusion.wave_coast.WaveCoast`) needs P for its first
+    model and for elements new to a later one only; the solution of a 217-state band costs
+    about 0.3 s, and the coast's five observers build a model every minute.
     """
 
     omega: np.ndarray
@@ -128,14 +137,27 @@ class BankModel:
     J: np.ndarray
     C: np.ndarray
     R: float
-    K: np.ndarray
-    P: np.ndarray
-    S: float
 
     @property
     def n(self) -> int:
         """State dimension 2m + 1."""
         return len(self.C)
+
+    @cached_property
+    def P(self) -> np.ndarray:
+        """(n, n) steady-state prior covariance (class docstring), symmetrised."""
+        _, p, _ = control.dlqe(self.A_bar, np.eye(self.n), self.C[None, :], self.Q, np.array([[self.R]]))
+        return 0.5 * (np.asarray(p) + np.asarray(p).T)
+
+    @cached_property
+    def S(self) -> float:
+        """Innovation variance C P Cᵀ + R."""
+        return float(self.C @ self.P @ self.C + self.R)
+
+    @cached_property
+    def K(self) -> np.ndarray:
+        """(n,) steady-state update gain P Cᵀ / S."""
+        return self.P @ self.C / self.S
 
     @cached_property
     def heave_rows(self) -> np.ndarray:
@@ -247,7 +269,7 @@ def build_bank(omega: np.ndarray, dt: float, mode_noise: float, offset_noise: fl
 def steady_state_filter(omega: np.ndarray, block: int, a: np.ndarray, q: np.ndarray, c: np.ndarray, dt: float,
                         acc_noise: float, measurement: str) -> BankModel:
     """The Kalman filter of a bank (modes of ``block`` states, then the offset) for either
-    measurement model, with its steady-state gain from ``dlqe``.
+    measurement model; its steady-state gain comes from ``dlqe`` on first use (:class:`BankModel`).
 
     Parameters
     ----------
@@ -279,10 +301,7 @@ def steady_state_filter(omega: np.ndarray, block: int, a: np.ndarray, q: np.ndar
         j = cross / r
         a_bar = a - np.outer(j, c)
         q = q - np.outer(cross, cross) / r                 # decorrelated process noise
-    _, p, _ = control.dlqe(a_bar, np.eye(n), c[None, :], q, np.array([[r]]))
-    p = 0.5 * (np.asarray(p) + np.asarray(p).T)
-    s = float(c @ p @ c + r)
-    return BankModel(omega, block, measurement, a, q, a_bar, j, c, r, p @ c / s, p, s)
+    return BankModel(omega, block, measurement, a, q, a_bar, j, c, r)
 
 
 def carry_map(old: np.ndarray, new: np.ndarray, block: int = 2) -> np.ndarray:
