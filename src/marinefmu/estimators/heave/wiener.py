@@ -411,14 +411,26 @@ class WienerAxis:
         return self.output()
 
     def record(self, a: float | None) -> None:
-        """:meth:`push` without its outputs: the sample into the buffers, and the bias-step
-        search and the design when they are due."""
-        a_v = self.mean if a is None else a - self.level
+        """:meth:`push` without its outputs: the sample into the buffers (:meth:`accept`, the
+        ring writes, :meth:`advance`), and the bias-step search and the design when they are
+        due."""
+        a_v = self.accept(a)
         self.spectrum_buf[self.k % len(self.spectrum_buf)] = a_v
         n_sum = self.n_fir + 1
         i = self.k % n_sum
-        self.total += a_v
         self.sum_buf[i] = self.sum_buf[i + n_sum] = self.total
+        self.advance()
+
+    def accept(self, a: float | None) -> float:
+        """The sample ``a`` [m/s²] as the buffers take it, a_v = a − level (the window's mean
+        for a bad one, None), added to the running sum; the ring writes follow."""
+        a_v = self.mean if a is None else a - self.level
+        self.total += a_v
+        return a_v
+
+    def advance(self) -> None:
+        """After a sample's ring writes: the sample count, and the bias-step search and the
+        design when they are due."""
         self.k += 1
         if self.find_steps and self.k % self.check_every == 0:
             self._check_bias_step()
@@ -468,9 +480,10 @@ class WienerAxis:
 class WienerGroup:
     """Several :class:`WienerAxis` filters stepped together, their outputs by one product.
 
-    Each axis keeps its own buffers, spectrum, design and bias-step search; the group only moves
-    their running sums into the rows of one array (each axis's ``sum_buf`` a view of its row,
-    so the axes' own in-place updates land there) and holds their taps zero-padded to the
+    Each axis keeps its own spectrum, design and bias-step search; the group moves their
+    sample rings and running sums into the rows of two arrays (each axis's ``spectrum_buf`` and
+    ``sum_buf`` a view of its row, so the axes' own in-place updates land there), writes a
+    sample of every axis with one store per ring, and holds their taps zero-padded to the
     longest memory, so that step 3 of all of them is one batched (A × 4 × L)·(A × L) product
     instead of one product and a dozen small numpy calls per axis. The outputs equal each
     axis's :meth:`WienerAxis.push` to rounding (the sums are formed in another order; the
@@ -479,34 +492,45 @@ class WienerGroup:
     Parameters
     ----------
     axes : sequence of WienerAxis
-        Filters with the same step and memory (the same ``dt``, ``block`` and ``blocks``),
-        pushed every step. Call :meth:`bind` after their ``start`` or ``set_state``, which
+        Filters with the same step, memory and spectrum window (the same ``dt``, ``block``,
+        ``blocks`` and ring lengths) and sample count, pushed every step. Call :meth:`bind` after their ``start`` or ``set_state``, which
         give them new buffers.
     """
 
     def __init__(self, axes: list[WienerAxis]) -> None:
         self.axes = list(axes)
         self.sums = np.zeros((len(self.axes), 0))
+        self.spectra = np.zeros((len(self.axes), 0))
         self._designs: list[np.ndarray | None] = []       # the taps the stack below was built from
         self._taps = np.zeros((len(self.axes), 4, 0))
         self._offsets = np.zeros((len(self.axes), 4))     # mean × the taps' sums, per axis
 
     def bind(self) -> None:
-        """Move the axes' running sums into one array (after their ``start`` or ``set_state``)."""
+        """Move the axes' rings into two arrays (after their ``start`` or ``set_state``)."""
         first = self.axes[0]
-        if any(a.dt != first.dt or a.block != first.block or a.blocks != first.blocks for a in self.axes):
-            raise ValueError("WienerGroup: the axes must share dt, block and blocks")
+        if any(a.dt != first.dt or a.block != first.block or a.blocks != first.blocks or a.k != first.k
+               or len(a.spectrum_buf) != len(first.spectrum_buf) for a in self.axes):
+            raise ValueError("WienerGroup: the axes must share dt, block, blocks, the window and the sample count")
         self.sums = np.stack([a.sum_buf for a in self.axes])
-        for row, axis in zip(self.sums, self.axes):
-            axis.sum_buf = row
+        self.spectra = np.stack([a.spectrum_buf for a in self.axes])
+        for axis, sums, spectrum in zip(self.axes, self.sums, self.spectra):
+            axis.sum_buf, axis.spectrum_buf = sums, spectrum
         self._designs = []
 
     def push(self, values: list[float | None]) -> np.ndarray | None:
         """One sample per axis (as :meth:`WienerAxis.push`): the (A, 4) outputs, a row per axis,
         or None while any axis has no design yet."""
         axes = self.axes
-        for axis, a in zip(axes, values):
-            axis.record(a)
+        first = axes[0]
+        a_v = [axis.accept(a) for axis, a in zip(axes, values)]     # WienerAxis.record for all axes
+        n_sum = first.n_fir + 1
+        i = first.k % n_sum
+        self.spectra[:, first.k % self.spectra.shape[1]] = a_v
+        totals = [axis.total for axis in axes]
+        self.sums[:, i] = totals
+        self.sums[:, i + n_sum] = totals
+        for axis in axes:
+            axis.advance()
         if len(self._designs) != len(axes) or any(a.taps is not t for a, t in zip(axes, self._designs)):
             if any(a.taps is None for a in axes):
                 return None
