@@ -40,16 +40,18 @@ def rot_nb(roll: float, pitch: float, yaw: float) -> np.ndarray:
     numpy.ndarray
         (3, 3) rotation matrix; ``R @ v_b`` gives the vector in NED.
     """
+    return np.array(rot_nb_rows(roll, pitch, yaw)).reshape(3, 3)
+
+
+def rot_nb_rows(roll: float, pitch: float, yaw: float) -> tuple[float, ...]:
+    """:func:`rot_nb`'s nine entries row by row, as Python floats (for per-sample code, where
+    an array costs more than the arithmetic)."""
     cf, sf = math.cos(roll), math.sin(roll)
     ct, st = math.cos(pitch), math.sin(pitch)
     cp, sp = math.cos(yaw), math.sin(yaw)
-    return np.array(
-        [
-            [cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf],
-            [sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf],
-            [-st, ct * sf, ct * cf],
-        ]
-    )
+    return (cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf,
+            sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf,
+            -st, ct * sf, ct * cf)
 
 
 def euler_rates_to_body(euler: np.ndarray, euler_dot: np.ndarray, euler_ddot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

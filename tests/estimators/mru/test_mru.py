@@ -2,6 +2,7 @@
 heading aid and its state."""
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -156,25 +157,39 @@ def test_a_step_size_change_restarts_with_a_warning(short):
     assert "step size changed" in r.warning and not r.valid and mru.k == 1
 
 
-def test_the_level_rotation_and_the_scalar_low_pass_are_the_general_ones_written_out():
-    """``level_rows`` is Rz(ψ̄)ᵀ R_nb(q) (to rounding), and ``push_float`` the vector low-pass
-    on one number bit for bit, its state in the vector's format."""
-    import math
+def test_the_level_rotation_the_low_pass_and_the_turn_map_are_the_general_ones_written_out():
+    """``level_rows`` is Rz(ψ̄)ᵀ R_nb(q) and ``rot_nb_rows`` R_nb (to rounding); the float
+    low-pass is scipy's ``lfilter`` of two first-order stages (from zero, and from the first
+    sample), through a state save; ``turn_map`` gives (R − I) r of every arm."""
+    from scipy.signal import lfilter
 
-    from marinefmu.estimators.mru.level_frame import SlowLowPass, level_rows, yaw_rotation
-    from marinefmu.frames import euler_to_quat, quat_to_rot
+    from marinefmu.estimators.mru.level_frame import SlowLowPass, level_rows, turn_map, yaw_rotation
+    from marinefmu.frames import euler_to_quat, quat_to_rot, rot_nb, rot_nb_rows
 
     for yaw_ref, angles in ((0.3, (0.05, -0.02, 1.1)), (-2.9, (0.2, 0.1, -3.0)), (math.pi, (0.0, 0.0, 0.0))):
         q = euler_to_quat(*angles)
         np.testing.assert_allclose(np.reshape(level_rows(yaw_ref, tuple(q)), (3, 3)),
                                    yaw_rotation(yaw_ref) @ quat_to_rot(q), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(np.reshape(rot_nb_rows(*angles), (3, 3)), quat_to_rot(q), rtol=0, atol=1e-15)
+        arms = np.array([[25.0, -3.0, -8.0], [0.0, 0.0, 0.0], [-40.0, 12.0, 5.0]])
+        rot = rot_nb(*angles)
+        np.testing.assert_allclose((turn_map(arms) @ (rot - np.eye(3)).ravel()).reshape(3, 3),
+                                   arms @ rot.T - arms, rtol=0, atol=1e-13)
     rng = np.random.default_rng(4)
-    x = rng.normal(size=500)
-    vector, scalar = SlowLowPass(30.0), SlowLowPass(30.0)
-    for k, v in enumerate(x):
-        assert scalar.push_float(float(v), 0.01) == vector.push(np.array([v]), 0.01)[0]
-        if k == 250:
-            assert scalar.get_state() == vector.get_state()
-            restored = SlowLowPass(30.0)
-            restored.set_state(scalar.get_state(), scalar=True)
-            scalar = restored
+    x = rng.normal(size=(500, 2))
+    alpha = 1.0 - math.exp(-0.01 / 30.0)
+    for from_zero in (True, False):
+        lp = SlowLowPass(30.0, from_zero=from_zero)
+        out = []
+        for k, v in enumerate(x):
+            out.append(lp.push(list(v), 0.01))
+            if k == 250:
+                restored = SlowLowPass(30.0, from_zero=from_zero)
+                restored.set_state(json.loads(json.dumps(lp.get_state())))
+                lp = restored
+        # from zero: both stages start at 0; else the first sample starts both and is returned as is
+        given, start = (x, np.zeros(2)) if from_zero else (x[1:], x[0])
+        expected = given
+        for _ in range(2):
+            expected = lfilter([alpha], [1.0, alpha - 1.0], expected, axis=0, zi=[(1.0 - alpha) * start])[0]
+        np.testing.assert_allclose(out, expected if from_zero else np.vstack([x[:1], expected]), rtol=1e-12, atol=1e-15)

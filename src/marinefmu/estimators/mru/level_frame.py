@@ -12,7 +12,9 @@ motion about its mean position adds d = (R_hb r − r) − ⟨R_hb r − r⟩ to
 is the slow low-pass (:data:`~.params.ARM_TAU`), started at zero: the mean of R_hb r is not r
 (a 2° roll and pitch shift a point 60 m away by 4 cm, the rectification of cos), and the
 low-pass removes what the mean position holds while passing the wave-frequency part to within
-(1/(ω τ))² (0.1 % at 0.3 rad/s).
+(1/(ω τ))² (0.1 % at 0.3 rad/s). Both terms are linear in R_hb, so every point's d is one
+product (:func:`turn_map`) with the nine entries of (R_hb − I) − ⟨R_hb − I⟩, the one series
+the unit filters and stores.
 Velocity and acceleration add ḋ and d̈, from a causal Savitzky-Golay fit (scipy's
 ``savgol_coeffs``) of degree :data:`DERIVATIVE_DEGREE` over the last :data:`DERIVATIVE_WINDOW`
 s, evaluated at the newest sample: a difference of two samples would take the gyro-integrated
@@ -22,6 +24,7 @@ while a wave (period ≥ 5 s) is a quartic over 1 s to within 0.3 % in ḋ.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -38,10 +41,11 @@ DERIVATIVE_DEGREE = 4
 
 
 class SlowLowPass:
-    """Two cascaded first-order low-passes with time constant ``tau`` [s] on a vector,
+    """Two cascaded first-order low-passes with time constant ``tau`` [s] on a few numbers,
     y/x = 1/(1 + sτ)², exact discretisation (α = 1 − exp(−Δt/τ)); starts at the first sample.
-    Hand-written: a per-sample two-pole recursion on a few numbers is cheaper inline than a
-    call into ``scipy.signal.lfilter``.
+    Hand-written, on Python floats: a per-sample two-pole recursion on a few numbers is cheaper
+    inline than a call into ``scipy.signal.lfilter`` or a numpy array per step (the tests check
+    it against ``lfilter``).
 
     Parameters
     ----------
@@ -54,52 +58,32 @@ class SlowLowPass:
     def __init__(self, tau: float, from_zero: bool = False) -> None:
         self.tau = tau
         self.from_zero = from_zero
-        self.stages: np.ndarray | list[float] | None = None   # (2, …) the two stages' outputs
+        self.stages: list[list[float]] | None = None   # the two stages' outputs
         self.dt, self.alpha = math.nan, 0.0         # the step the coefficient was computed for
 
-    def push(self, x: np.ndarray, dt: float) -> np.ndarray:
-        """The low-passed ``x`` after one step ``dt`` [s]."""
+    def push(self, x: Sequence[float], dt: float) -> list[float]:
+        """The low-passed ``x`` (floats) after one step ``dt`` [s]."""
         if self.stages is None:
-            self.stages = np.stack([x, x]).astype(float) * (0.0 if self.from_zero else 1.0)
-            if not self.from_zero:
-                return self.stages[1].copy()
-        if dt != self.dt:
-            self.dt, self.alpha = dt, 1.0 - math.exp(-dt / self.tau)
-        alpha = self.alpha
-        self.stages[0] += alpha * (x - self.stages[0])
-        self.stages[1] += alpha * (self.stages[0] - self.stages[1])
-        return self.stages[1].copy()
-
-    def push_float(self, x: float, dt: float) -> float:
-        """:meth:`push` for one number, on Python floats: the same operations in the same order,
-        so the same result bit for bit, without a numpy array per step."""
-        if self.stages is None:
-            start = 0.0 if self.from_zero else float(x)
+            start = [0.0] * len(x) if self.from_zero else [float(v) for v in x]
             self.stages = [start, start]
             if not self.from_zero:
                 return start
         if dt != self.dt:
             self.dt, self.alpha = dt, 1.0 - math.exp(-dt / self.tau)
-        s0, s1 = self.stages
-        s0 += self.alpha * (x - s0)
-        s1 += self.alpha * (s0 - s1)
-        self.stages = [s0, s1]
-        return s1
+        alpha = self.alpha
+        first, second = self.stages
+        first = [s + alpha * (v - s) for s, v in zip(first, x)]
+        second = [s + alpha * (f - s) for s, f in zip(second, first)]
+        self.stages = [first, second]
+        return second
 
     def get_state(self) -> list | None:
-        """JSON-serialisable state (a scalar's as a vector of one)."""
-        if self.stages is None:
-            return None
-        return [[v] for v in self.stages] if isinstance(self.stages, list) else self.stages.tolist()
+        """JSON-serialisable state."""
+        return None if self.stages is None else [list(v) for v in self.stages]
 
-    def set_state(self, s: list | None, scalar: bool = False) -> None:
-        """Restore a state from :meth:`get_state`; ``scalar`` for one pushed with :meth:`push_float`."""
-        if s is None:
-            self.stages = None
-        elif scalar:
-            self.stages = [float(v[0]) for v in s]
-        else:
-            self.stages = np.array(s, dtype=float)
+    def set_state(self, s: list | None) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.stages = None if s is None else [[float(v) for v in stage] for stage in s]
 
 
 def yaw_rotation(yaw: float) -> np.ndarray:
@@ -121,6 +105,17 @@ def level_rows(yaw_ref: float, q: Any) -> tuple[float, ...]:
     return (c * a0 + s * b0, c * a1 + s * b1, c * a2 + s * b2,
             c * b0 - s * a0, c * b1 - s * a1, c * b2 - s * a2,
             2.0 * (x * z - w * y), 2.0 * (y * z + w * x), ww - xx - yy + zz)
+
+
+def turn_map(arms: np.ndarray) -> np.ndarray:
+    """(3P, 9) map M from R's entries row by row to R r_p for the P lever arms ``arms`` (P, 3)
+    [m]: M_p[i, 3i + j] = r_p,j, so that (R − I) r_p for every point is one product with the
+    nine entries of R − I, and so are its mean, rate and acceleration (linear in R)."""
+    arms = np.asarray(arms, dtype=float).reshape(-1, 3)
+    m = np.zeros((len(arms), 3, 3, 3))
+    for i in range(3):
+        m[:, i, i, :] = arms
+    return m.reshape(3 * len(arms), 9)
 
 
 def unwrap(previous: float, yaw: float) -> float:

@@ -35,9 +35,10 @@ Per sample (:meth:`MotionReferenceUnit.step`):
 What runs when: every step, the attitude, the level frame's rows and a_h on Python floats
 (:func:`~.level_frame.level_rows`), each filter's ring writes and the four filters' outputs
 as one batched product (:class:`~marinefmu.estimators.heave.wiener.WienerGroup`), and the
-points' arms (one rotation, one low-pass, one (2 × W)·(W × 3P) product on a contiguous slice of
-the arm ring, stored twice for it, for their rates and accelerations); every second, the heave
-filter's bias-step search;
+points' arms: the nine entries of R − I and their slow mean on floats, one (2 × W)·(W × 9)
+product on a contiguous slice of their ring (stored twice for it) for the rates and
+accelerations, and one (4 × 9)·(9 × 3P) product to every point (:func:`~.level_frame.turn_map`);
+every second, the heave filter's bias-step search;
 first after ``motion.window`` s and then every :data:`DESIGN_ROUNDS` × ``motion.peak_interval``
 s, each filter's Wiener design, the four a quarter of an interval apart (on average one
 design per interval in all, as the HeaveObserver), so that no step designs more than one.
@@ -58,12 +59,12 @@ from typing import Any
 
 import numpy as np
 
-from ...frames import G, rot_nb
+from ...frames import G, rot_nb_rows
 from ..attitude.estimator import AttitudeEstimator, AttitudeResult
 from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW
-from .level_frame import SlowLowPass, derivative_weights, level_rows, unwrap
+from .level_frame import SlowLowPass, derivative_weights, level_rows, turn_map, unwrap
 from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
@@ -74,6 +75,8 @@ log = logging.getLogger(__name__)
 DESIGN_ROUNDS = 4
 #: The level frame's axes, in the order of the outputs' columns.
 AXES = ("surge", "sway", "heave")
+#: The identity's entries row by row.
+IDENTITY_ROWS = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 
 
 def yaw_filter_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
@@ -114,6 +117,7 @@ class MotionReferenceUnit:
         self.params = params or MotionReferenceUnitParams()
         self.log: Any = SilentLog() if quiet else log
         self.arms = np.array(self.params.points, dtype=float).reshape(-1, 3)      # (P, 3) body [m]
+        self.turn_map_t = np.ascontiguousarray(turn_map(self.arms).T)           # (9, 3P): (R − I) → (R − I) r
         self.reset()
 
     def reset(self) -> None:
@@ -125,14 +129,15 @@ class MotionReferenceUnit:
         self.yaw_axis = WienerAxis(yaw_filter_params(p), self.log, "mru yaw", reject_below=True, find_steps=False)
         self.group = WienerGroup([*self.axes, self.yaw_axis] if len(self.arms) else self.axes)
         self.yaw_ref = SlowLowPass(YAW_TAU)
-        self.arm_mean = SlowLowPass(ARM_TAU, from_zero=True)
+        self.turn_mean = SlowLowPass(ARM_TAU, from_zero=True)    # ⟨R − I⟩, the arms' mean turn
         self.dt: float | None = None
         self.k = 0
         self.yaw: float | None = None                 # the unwrapped gyro yaw [rad]
         self.heading_offset: float | None = None      # c of the heading aid [rad]
         self.rot_rows = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)   # R_hb of the last good sample, row by row
         self.heave_acc = 0.0                          # the last good vertical acceleration [m/s²]
-        self.arm_ring = np.zeros((0, len(self.arms), 3))
+        self.turn_ring = np.zeros((0, 9))
+        self.terms = np.zeros((4, 9))
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -146,7 +151,10 @@ class MotionReferenceUnit:
         self.lag_steps = self.axes[0].lag_steps
         self.group.bind()
         ring = max(self.lag_steps + 1, self.weights.shape[1])
-        self.arm_ring = np.zeros((2 * ring, len(self.arms), 3))    # each sample twice: the last W are one slice
+        # (R_hb − I) − ⟨R_hb − I⟩ row by row (level_frame: every point's d is a product with it),
+        # each sample twice, so that the last W are one slice
+        self.turn_ring = np.zeros((2 * ring, 9))
+        self.terms = np.zeros((4, 9))    # the turn's position, rate, acceleration and delayed position
         self.delayed_from = m.window + m.peak_interval * 3.0 / 4.0 + self.axes[0].delay
 
     @property
@@ -188,7 +196,7 @@ class MotionReferenceUnit:
         a_h = None
         if good:
             self.yaw = att.yaw if self.yaw is None else unwrap(self.yaw, att.yaw)
-            r = self.rot_rows = level_rows(self.yaw_ref.push_float(self.yaw, dt), att.q)
+            r = self.rot_rows = level_rows(self.yaw_ref.push([self.yaw], dt)[0], att.q)
             f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
             a_h = (r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2,
                    r[6] * f0 + r[7] * f1 + r[8] * f2 + G)
@@ -197,19 +205,22 @@ class MotionReferenceUnit:
         if points:                                     # the yaw filter serves the lever arms only
             values.append(euler_yaw_rate(gyro, att) if good else None)
         out = self.group.push(values)                  # (axes, 4): position, rate, delayed position, rate
-        n = len(self.arm_ring) // 2
+        ring = self.turn_ring
+        n = len(ring) // 2
         if points:
             i = self.k % n
-            if good or self.k == 0:
+            if good:
                 if out is not None:
                     yaw_wave = float(out[3, 1])
                 else:                                  # some filter not yet designed: the yaw one may be
                     yaw_wave = None if self.yaw_axis.taps is None else float(self.yaw_axis.output()[1])
-                rot = self.rot if yaw_wave is None else rot_nb(att.roll, att.pitch, yaw_wave)
-                arm = self.arms @ rot.T - self.arms                              # (P, 3): R_hb r − r
-                self.arm_ring[i] = self.arm_ring[i + n] = arm - self.arm_mean.push(arm, dt) if good else 0.0
+                rot = self.rot_rows if yaw_wave is None else rot_nb_rows(att.roll, att.pitch, yaw_wave)
+                turn = [v - e for v, e in zip(rot, IDENTITY_ROWS)]              # R_hb − I
+                ring[i] = ring[i + n] = [t - m for t, m in zip(turn, self.turn_mean.push(turn, dt))]
+            elif self.k == 0:
+                ring[i] = ring[i + n] = 0.0
             else:
-                self.arm_ring[i] = self.arm_ring[i + n] = self.arm_ring[(self.k - 1) % n]
+                ring[i] = ring[i + n] = ring[(self.k - 1) % n]
         self.k += 1
         heave_axis = self.axes[2]
         if a_h is not None:
@@ -225,19 +236,20 @@ class MotionReferenceUnit:
         o = out[:3, :3].T                          # (3, 3 axes): position, rate, delayed position
         w = self.weights.shape[1]
         j = (self.k - 1) % n                       # the newest sample's row
+        terms = self.terms
+        terms[0] = ring[j]
         if self.k >= w:
-            recent = self.arm_ring[j + n - w + 1:j + n + 1]                  # (W, P, 3), oldest first
-            d_rate = (self.weights @ recent.reshape(w, -1)).reshape(2, points, 3)
+            np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1:3])   # oldest first
         else:
-            d_rate = np.zeros((2, points, 3))
+            terms[1:3] = 0.0
+        terms[3] = ring[(self.k - 1 - self.lag_steps) % n]
+        at = (terms @ self.turn_map_t).reshape(4, points, 3)      # d, ḋ, d̈ and the delayed d per point
         motion = np.empty((3, rows, 3))            # position, velocity, delayed position: IMU, then points
         motion[:, 0] = o
-        np.add(o[0], self.arm_ring[j], out=motion[0, 1:])
-        np.add(o[1], d_rate[0], out=motion[1, 1:])
-        np.add(o[2], self.arm_ring[(self.k - 1 - self.lag_steps) % n], out=motion[2, 1:])
+        np.add(o[:, None, :], at[[0, 1, 3]], out=motion[:, 1:])
         heave_acc = np.empty(rows)
         heave_acc[0] = self.heave_acc
-        np.add(self.heave_acc, d_rate[1][:, 2], out=heave_acc[1:])
+        np.add(self.heave_acc, at[2, :, 2], out=heave_acc[1:])
         return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], heave_acc, motion[2], self.delay,
                          heave_axis.peak_period, angles_valid, good, good and self.k * dt >= self.delayed_from,
                          heading_used, warning)
@@ -266,9 +278,8 @@ class MotionReferenceUnit:
         return {"dt": self.dt, "k": self.k, "attitude": self.attitude.get_state(),
                 "axes": [axis.get_state() for axis in self.axes], "yaw_axis": self.yaw_axis.get_state(),
                 "yaw_ref": self.yaw_ref.get_state(),
-                "arm_mean": self.arm_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
-                "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "arm_ring": self.arm_ring.ravel().tolist(),
-                "arm_ring_shape": list(self.arm_ring.shape)}
+                "turn_mean": self.turn_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
+                "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist()}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -281,9 +292,9 @@ class MotionReferenceUnit:
             axis.set_state(st)
         self.yaw_axis.set_state(s["yaw_axis"])
         self.group.bind()
-        self.yaw_ref.set_state(s["yaw_ref"], scalar=True)
-        self.arm_mean.set_state(s["arm_mean"])
+        self.yaw_ref.set_state(s["yaw_ref"])
+        self.turn_mean.set_state(s["turn_mean"])
         self.yaw, self.heading_offset = s["yaw"], s["heading_offset"]
         self.rot_rows = tuple(float(v) for v in np.ravel(s["rot"]))
         self.heave_acc = float(s["heave_acc"])
-        self.arm_ring = np.array(s["arm_ring"], dtype=float).reshape(s["arm_ring_shape"])
+        self.turn_ring = np.array(s["turn_ring"], dtype=float).reshape(-1, 9)
