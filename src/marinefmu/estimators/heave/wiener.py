@@ -480,11 +480,10 @@ class WienerAxis:
 class WienerGroup:
     """Several :class:`WienerAxis` filters stepped together, their outputs by one product.
 
-    Each axis keeps its own spectrum, design and bias-step search; the group moves their
-    sample rings and running sums into the rows of two arrays (each axis's ``spectrum_buf`` and
-    ``sum_buf`` a view of its row, so the axes' own in-place updates land there), writes a
-    sample of every axis with one store per ring, and holds their taps zero-padded to the
-    longest memory, so that step 3 of all of them is one batched (A × 4 × L)·(A × L) product
+    Each axis keeps its own buffers, spectrum, design and bias-step search; the group moves their
+    running sums into the rows of one array (each axis's ``sum_buf`` a view of its row, so the
+    axes' own in-place updates land there), writes a step's sums with one store per copy, and
+    holds their taps zero-padded to the longest memory, so that step 3 of all of them is one batched (A × 4 × L)·(A × L) product
     instead of one product and a dozen small numpy calls per axis. The outputs equal each
     axis's :meth:`WienerAxis.push` to rounding (the sums are formed in another order; the
     padding multiplies finite sums by zero).
@@ -492,29 +491,28 @@ class WienerGroup:
     Parameters
     ----------
     axes : sequence of WienerAxis
-        Filters with the same step, memory and spectrum window (the same ``dt``, ``block``,
-        ``blocks`` and ring lengths) and sample count, pushed every step. Call :meth:`bind` after their ``start`` or ``set_state``, which
+        Filters with the same step and memory (the same ``dt``, ``block`` and ``blocks``) and
+        sample count, pushed every step. (The spectrum rings stay apart: at a step of 1 µs each
+        is gigabytes of untouched zeros, which a stacked copy would have to write.) Call :meth:`bind` after their ``start`` or ``set_state``, which
         give them new buffers.
     """
 
     def __init__(self, axes: list[WienerAxis]) -> None:
         self.axes = list(axes)
         self.sums = np.zeros((len(self.axes), 0))
-        self.spectra = np.zeros((len(self.axes), 0))
         self._designs: list[np.ndarray | None] = []       # the taps the stack below was built from
         self._taps = np.zeros((len(self.axes), 4, 0))
         self._offsets = np.zeros((len(self.axes), 4))     # mean × the taps' sums, per axis
 
     def bind(self) -> None:
-        """Move the axes' rings into two arrays (after their ``start`` or ``set_state``)."""
+        """Move the axes' running sums into one array (after their ``start`` or ``set_state``)."""
         first = self.axes[0]
         if any(a.dt != first.dt or a.block != first.block or a.blocks != first.blocks or a.k != first.k
-               or len(a.spectrum_buf) != len(first.spectrum_buf) for a in self.axes):
-            raise ValueError("WienerGroup: the axes must share dt, block, blocks, the window and the sample count")
+               for a in self.axes):
+            raise ValueError("WienerGroup: the axes must share dt, block, blocks and the sample count")
         self.sums = np.stack([a.sum_buf for a in self.axes])
-        self.spectra = np.stack([a.spectrum_buf for a in self.axes])
-        for axis, sums, spectrum in zip(self.axes, self.sums, self.spectra):
-            axis.sum_buf, axis.spectrum_buf = sums, spectrum
+        for row, axis in zip(self.sums, self.axes):
+            axis.sum_buf = row
         self._designs = []
 
     def push(self, values: list[float | None]) -> np.ndarray | None:
@@ -524,8 +522,10 @@ class WienerGroup:
         first = axes[0]
         a_v = [axis.accept(a) for axis, a in zip(axes, values)]     # WienerAxis.record for all axes
         n_sum = first.n_fir + 1
-        i = first.k % n_sum
-        self.spectra[:, first.k % self.spectra.shape[1]] = a_v
+        k = first.k
+        i = k % n_sum
+        for axis, v in zip(axes, a_v):
+            axis.spectrum_buf[k % len(axis.spectrum_buf)] = v
         totals = [axis.total for axis in axes]
         self.sums[:, i] = totals
         self.sums[:, i + n_sum] = totals

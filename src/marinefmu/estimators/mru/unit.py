@@ -152,8 +152,9 @@ class MotionReferenceUnit:
         self.group.bind()
         ring = max(self.lag_steps + 1, self.weights.shape[1])
         # (R_hb − I) − ⟨R_hb − I⟩ row by row (level_frame: every point's d is a product with it),
-        # each sample twice, so that the last W are one slice
-        self.turn_ring = np.zeros((2 * ring, 9))
+        # each sample twice, so that the last W are one slice; none without points (its length
+        # grows as 1/dt: a 1 µs step would take gigabytes)
+        self.turn_ring = np.zeros((2 * ring if len(self.arms) else 0, 9))
         self.terms = np.zeros((4, 9))    # the turn's position, rate, acceleration and delayed position
         self.delayed_from = m.window + m.peak_interval * 3.0 / 4.0 + self.axes[0].delay
 
@@ -234,22 +235,23 @@ class MotionReferenceUnit:
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros.copy(), np.zeros(rows), zeros.copy(),
                              self.delay, heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
         o = out[:3, :3].T                          # (3, 3 axes): position, rate, delayed position
-        w = self.weights.shape[1]
-        j = (self.k - 1) % n                       # the newest sample's row
-        terms = self.terms
-        terms[0] = ring[j]
-        if self.k >= w:
-            np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1:3])   # oldest first
-        else:
-            terms[1:3] = 0.0
-        terms[3] = ring[(self.k - 1 - self.lag_steps) % n]
-        at = (terms @ self.turn_map_t).reshape(4, points, 3)      # d, ḋ, d̈ and the delayed d per point
         motion = np.empty((3, rows, 3))            # position, velocity, delayed position: IMU, then points
         motion[:, 0] = o
-        np.add(o[:, None, :], at[[0, 1, 3]], out=motion[:, 1:])
         heave_acc = np.empty(rows)
         heave_acc[0] = self.heave_acc
-        np.add(self.heave_acc, at[2, :, 2], out=heave_acc[1:])
+        if points:
+            w = self.weights.shape[1]
+            j = (self.k - 1) % n                   # the newest sample's row
+            terms = self.terms
+            terms[0] = ring[j]
+            if self.k >= w:
+                np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1:3])   # oldest first
+            else:
+                terms[1:3] = 0.0
+            terms[3] = ring[(self.k - 1 - self.lag_steps) % n]
+            at = (terms @ self.turn_map_t).reshape(4, points, 3)      # d, ḋ, d̈ and the delayed d per point
+            np.add(o[:, None, :], at[[0, 1, 3]], out=motion[:, 1:])
+            np.add(self.heave_acc, at[2, :, 2], out=heave_acc[1:])
         return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], heave_acc, motion[2], self.delay,
                          heave_axis.peak_period, angles_valid, good, good and self.k * dt >= self.delayed_from,
                          heading_used, warning)
