@@ -510,8 +510,10 @@ class WienerGroup:
         if any(a.dt != first.dt or a.block != first.block or a.blocks != first.blocks or a.k != first.k
                for a in self.axes):
             raise ValueError("WienerGroup: the axes must share dt, block, blocks and the sample count")
-        self.sums = np.stack([a.sum_buf for a in self.axes])
+        self.sums = np.zeros((len(self.axes), len(first.sum_buf)))
         for row, axis in zip(self.sums, self.axes):
+            if axis.k:             # restored or running: carry its sums (fresh ones are zeros, left untouched)
+                row[:] = axis.sum_buf
             axis.sum_buf = row
         self._designs = []
 
