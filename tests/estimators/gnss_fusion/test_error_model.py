@@ -239,3 +239,29 @@ def test_the_held_attitude_measures_the_rate_from_fix_to_fix():
     gyro = error_model()
     gyro.held_rotation(change, 1.0, std)
     assert gyro.rate_var is None
+
+
+def test_the_output_variance_on_its_two_blocks_is_the_full_product_and_the_step_reuses_the_fix_turned_rotation():
+    """``position_var`` reads only the position and attitude blocks of the joint covariance:
+    it must equal diag(M J Mᵀ) with the whole output map M (:meth:`FusionError.output_map`) to
+    rounding (1e-12 relative; the other columns of M are zeros). The step's output reuses the
+    rotation of its propagated attitude unless a fix has turned the attitude since: the output
+    must equal one made from the attitude as it stands, on fix steps and between them."""
+    rec = paper001.simulate(60.0, {"gnss.rate": 1.0, "sea.seed": 2, "sensors.seed": 2})
+    est = GnssAccFusion(paper001.params())
+    assert np.linalg.norm(est.error.acc_arm) > 0.5          # the attitude block matters
+    use = rec["gnss_new"] & rec["gnss_valid"]
+    fixes = checked = 0
+    for k in range(len(rec["acc"])):
+        r = est.step(rec["acc"][k], rec["gnss"][k] if use[k] else None, paper001.DT, rec["gyro"][k])
+        if k < 1000 or k % 7 and not use[k]:
+            continue
+        rot = gnss_fusion.quat_to_rot(est.q)
+        m = est.error.output_map(rot)
+        full = np.einsum("ij,jk,ik->i", m, est.error.joint, m)
+        np.testing.assert_allclose(est.error.position_var(rot), full, rtol=1e-12, atol=0.0)
+        again = est._result(r.fix, r.valid, r.warning, np.asarray(rec["gyro"][k], dtype=float))
+        assert again.pos == r.pos and again.vel == r.vel and again.pos_std == r.pos_std
+        fixes += bool(r.fix)
+        checked += 1
+    assert fixes >= 40 and checked >= 600, (fixes, checked)

@@ -383,11 +383,20 @@ class FusionError:
         return m
 
     def position_var(self, rot: np.ndarray) -> np.ndarray:
-        """Variance of the COG output per NED axis [m²] (``rot`` the attitude R_nb used)."""
+        """Variance of the COG output per NED axis [m²] (``rot`` the attitude R_nb used).
+
+        diag(M J Mᵀ) with M = [I 0 A 0] of :meth:`output_map`, A = −[R̂ l]×, written on the
+        two 3 × 3 blocks M touches (position p and attitude ε; J symmetric):
+        var_i = J_pp,ii + 2 Σ_k A_ik J_pε,ik + (A J_εε Aᵀ)_ii. Called every step; the full
+        product would multiply the other states' zero columns too."""
         if self.joint is None:
             return np.zeros(3)
-        m = self.output_map(rot)
-        return np.maximum(np.einsum("ij,jk,ik->i", m, self.joint, m), 0.0)   # rounding: never negative
+        nx = len(self.joint) - 9
+        a = -skew(rot @ self.acc_arm)
+        j = self.joint
+        var = (np.diagonal(j)[:3] + 2.0 * np.einsum("ik,ik->i", j[:3, nx:nx + 3], a)
+               + np.einsum("ij,jk,ik->i", a, j[nx:nx + 3, nx:nx + 3], a))
+        return np.maximum(var, 0.0)   # rounding: never negative
 
     # ---- state -------------------------------------------------------------------------------
     def get_state(self) -> dict:

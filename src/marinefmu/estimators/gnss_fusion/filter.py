@@ -715,7 +715,7 @@ class GnssAccFusion:
                 self.q_coast = propagate(self.q_coast, w_step - self.coast_bias, dt)
                 if p.propagation == "hold" and self.since_fix > HOLD_OVERDUE * self.fix_interval:
                     self.q = self.q_coast.copy()    # no fix to hold: the gyro's attitude
-        rot = quat_to_rot(self.q)
+        rot, q_rot = quat_to_rot(self.q), self.q
         start = self.acc_n if self.initialised else None  # a_n at the start of the step
         self.acc_n = (rot @ f_b if p.attitude_correction else f_b) + GRAVITY_N
         u = self.acc_n if p.step_input == "latest" or start is None else 0.5 * (start + self.acc_n)
@@ -752,7 +752,9 @@ class GnssAccFusion:
         # accelerometer one: the output coasts and is flagged for that step
         valid = (good and fix not in ("skipped", "rejected") and self.initialised and self.since_fix <= p.max_coast
                  and not self._stale_attitude())
-        return self._result(fix, valid, warning, w)
+        # the output's rotation is this one unless a fix has turned the attitude since (every
+        # change of q assigns a new array)
+        return self._result(fix, valid, warning, w, rot if self.q is q_rot else None)
 
     def _epoch(self, gnss: Any, dt: float) -> tuple[str, str | None]:
         p = self.run_params
@@ -952,9 +954,11 @@ class GnssAccFusion:
         self.q, self.gyro_bias = pi_pull(self.q, self.gyro_bias, rot_fix, dt_fix, p.attitude_tau, alpha)
         self.error.attitude_fix(fix_std, dt_fix, alpha)
 
-    def _result(self, fix: str, valid: bool, warning: str | None, w: np.ndarray | None) -> GnssAccFusionResult:
+    def _result(self, fix: str, valid: bool, warning: str | None, w: np.ndarray | None,
+                rot: np.ndarray | None = None) -> GnssAccFusionResult:
+        """The step's output; ``rot``: R_nb of the current ``q`` when already computed."""
         p = self.run_params
-        rot = quat_to_rot(self.q)
+        rot = quat_to_rot(self.q) if rot is None else rot
         x = self.kf.x.ravel()
         arm = rot @ np.asarray(p.acc_lever_arm)
         pos = x[:3] - arm if self.initialised else np.zeros(3)
