@@ -213,3 +213,49 @@ def test_floating_hemisphere_surge_matches_hulme_1982():
         mu, lam = HULME_SURGE[k]
         assert r.added_mass[i, 0, 0] / ref_mass == pytest.approx(mu, rel=0.045), f"added mass at K = {k}"
         assert r.damping[i, 0, 0] / (ref_mass * omega[i]) == pytest.approx(lam, rel=0.045, abs=0.001), f"damping at K = {k}"
+
+
+def test_the_green_function_waits_for_a_tabulation_another_process_is_writing(barge, tmp_path, caplog):
+    """Capytaine writes its tabulation cache in place; a truncated file (another process still
+    writing) must be waited for and then loaded, not computed again or raised as BadZipFile.
+    The writer is played by a thread that puts the whole file in place after 1 s."""
+    import glob
+    import os
+    import shutil
+    import threading
+
+    from capytaine.tools.cache_on_disk import cache_directory
+
+    whole = bem.green_function()        # the barge fixture has solved: the cache holds the file
+    src = max(glob.glob(os.path.join(cache_directory(), "tabulation_*.npz")), key=os.path.getmtime)
+    name = tmp_path / os.path.basename(src)
+    shutil.copyfile(src, tmp_path / "whole.part")
+    name.write_bytes((tmp_path / "whole.part").read_bytes()[:100_000])    # mid-write
+    writer = threading.Timer(1.0, os.replace, (tmp_path / "whole.part", name))
+    writer.start()
+    with caplog.at_level("WARNING"):
+        g = bem.green_function(cache_dir=str(tmp_path), attempts=20, wait=0.25)
+    writer.join()
+    assert not any("Precomputing" in r.getMessage() or "in memory" in r.getMessage() for r in caplog.records)
+    np.testing.assert_array_equal(g.tabulated_integrals, whole.tabulated_integrals)
+
+
+def test_the_green_function_computes_in_memory_when_the_tabulation_stays_unreadable(tmp_path, monkeypatch, caplog):
+    """After ``attempts`` truncated loads the tabulation is computed without the cache, with a warning."""
+    import zipfile
+
+    import capytaine as cpt
+
+    calls = []
+
+    def fake(tabulation_cache_dir=None):
+        calls.append(tabulation_cache_dir)
+        if tabulation_cache_dir is not None:
+            raise zipfile.BadZipFile("File is not a zip file")
+        return "computed"
+
+    monkeypatch.setattr(cpt, "Delhommeau", fake)
+    with caplog.at_level("WARNING"):
+        assert bem.green_function(cache_dir=str(tmp_path), attempts=3, wait=0.0) == "computed"
+    assert calls == [str(tmp_path)] * 3 + [None]
+    assert any("in memory" in r.getMessage() for r in caplog.records)

@@ -258,6 +258,41 @@ def max_panel_radius(hull: HullMesh) -> float:
     return float(np.linalg.norm(p - c[:, None, :], axis=2).max())
 
 
+def green_function(cache_dir: str | None = None, attempts: int = 20, wait: float = 1.0):
+    """Capytaine's Delhommeau Green function, its tabulation loaded from Capytaine's disk
+    cache when whole.
+
+    Capytaine writes the tabulation (8.5 MB, about 20 s to compute on a 2-core machine) in
+    place, so a second process that loads it while the first is still writing gets a truncated
+    zip file (``zipfile.BadZipFile``, which Capytaine does not catch; seen with two test
+    workers on a fresh machine). Then this waits ``wait`` s and loads again, up to
+    ``attempts`` times, and after that computes the tabulation in memory with a warning.
+
+    Parameters
+    ----------
+    cache_dir : str, optional
+        Tabulation cache folder (default Capytaine's ``cache_directory()``).
+    attempts : int
+        Loads tried before computing in memory.
+    wait : float
+        Pause between loads [s].
+    """
+    import zipfile
+
+    import capytaine as cpt
+    from capytaine.tools.cache_on_disk import cache_directory
+
+    folder = cache_directory() if cache_dir is None else cache_dir
+    for _ in range(attempts):
+        try:
+            return cpt.Delhommeau(tabulation_cache_dir=folder)
+        except zipfile.BadZipFile:     # another process is writing the file
+            time.sleep(wait)
+    logging.getLogger(__name__).warning("Capytaine's Green-function tabulation in %s stays unreadable after %d "
+                                        "tries; computing it in memory", folder, attempts)
+    return cpt.Delhommeau(tabulation_cache_dir=None)
+
+
 def _solver_mesh(hull: HullMesh, shift_xy: np.ndarray):
     """The Capytaine mesh of ``hull``, the COG moved to x = y = 0 (the RAOs' phase reference)."""
     import capytaine as cpt
@@ -412,7 +447,7 @@ def _solve(hull: HullMesh, mass: MassProperties, omega: np.ndarray | None, headi
                                  f"{label} metacentric height GM = {gm:.3g} m ≤ 0; lower the centre of gravity")
 
     beta_solver = np.mod(-heading, 2 * math.pi)     # Capytaine's direction: from x towards port
-    solver = cpt.BEMSolver()
+    solver = cpt.BEMSolver(green_function=green_function())
 
     def problems(w: float) -> list:
         rad = [cpt.RadiationProblem(body=body, radiating_dof=d, omega=float(w), rho=rho, g=g) for d in DOF_NAMES]
