@@ -1,6 +1,7 @@
 """Shared fixtures: the built FMUs (built once per session if missing or stale)."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from fmpy import extract, read_model_description
@@ -28,6 +29,20 @@ def relay_fmu(tmp_path_factory) -> Path:
     dest = tmp_path_factory.mktemp("relay")
     build_all(models=ROOT / "tests" / "models", dest=dest, verbose=False)
     return dest / "MfTestRelay.fmu"
+
+
+def spawn_env(env: dict[str, str] | None = None) -> dict[str, str]:
+    """The environment to give a child process started from a worker thread: ``env``, or a copy
+    of this process's.
+
+    Never start such a child with ``env=None``. Then ``subprocess`` vforks and the child
+    execs with the C ``environ``, shared with the parent until exec. Meanwhile the main thread
+    runs the next test, and pytest sets and unsets ``PYTEST_CURRENT_TEST`` at every phase:
+    glibc's ``setenv`` moves the array, and the child's exec fails with ``EFAULT``
+    ("[Errno 14] Bad address"). An explicit environment is copied into the child's own ``envp``
+    before the fork.
+    """
+    return dict(os.environ) if env is None else env
 
 
 DT = 0.01

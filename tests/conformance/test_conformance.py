@@ -18,6 +18,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from fmu_worker import FMUS  # noqa: E402
 
+from tests.conftest import spawn_env  # noqa: E402
+
 pytestmark = pytest.mark.fmu
 TIMEOUT = 300.0  # s per case; the slowest takes ~15 s on the 2-core CI machine
 ESTIMATORS = [n for n in FMUS if n != "VesselMotion"]
@@ -41,7 +43,8 @@ def run_worker(case: str, name: str, fmu_dir: Path, work: Path) -> dict:
     """Run one case in a fresh process; its JSON result, or a failure naming how it died."""
     cmd = [sys.executable, str(HERE / "fmu_worker.py"), case, name, str(fmu_dir), str(work)]
     try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT, cwd=work)
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT, cwd=work,
+                              env=spawn_env())
     except subprocess.TimeoutExpired:
         return {"_failure": f"{case} {name}: no answer within {TIMEOUT:.0f} s (hang)"}
     lines = done.stdout.strip().splitlines()

@@ -32,6 +32,8 @@ sys.path.insert(0, str(HERE))
 from fmu_worker import FMUS  # noqa: E402
 from test_conformance import run_worker  # noqa: E402
 
+from tests.conftest import spawn_env  # noqa: E402
+
 pytestmark = pytest.mark.fmu
 ALL = ",".join(FMUS)
 #: (case, FMUs run together in one process)
@@ -200,7 +202,7 @@ def valgrind_runs(request, valgrind, relay_fmu, tmp_path_factory):
     def run(tag: str, cmd: list[str], env: dict | None) -> tuple[int, str, str]:
         log = work / f"{tag}.log"
         done = subprocess.run([valgrind, "--undef-value-errors=no", "--leak-check=no", f"--log-file={log}", *cmd],
-                              capture_output=True, text=True, timeout=VALGRIND_TIMEOUT, env=env)
+                              capture_output=True, text=True, timeout=VALGRIND_TIMEOUT, env=spawn_env(env))
         return done.returncode, done.stdout + done.stderr[-2000:], log.read_text()
 
     pool = ThreadPoolExecutor(max_workers=2)
