@@ -1,11 +1,13 @@
 """The heave estimators' per-sample path: :func:`read_sample`'s float check against the full
-array check, and the WienerHeave's (roll, pitch) ring through a JSON state."""
+array check, the bank's answer before its first model, and the WienerHeave's (roll, pitch)
+ring through a JSON state."""
 import json
 import math
 
 import numpy as np
 import pytest
 
+from marinefmu.estimators.heave.bank import OscillatorBankHeave
 from marinefmu.estimators.heave.common import HeaveObserverParams, _bad_sample, read_sample
 from marinefmu.estimators.heave.wiener import WienerHeave
 from marinefmu.estimators.samples import MAX_TILT
@@ -23,6 +25,15 @@ from marinefmu.estimators.samples import MAX_TILT
     ((0.0, 0.0, -9.8), 0.0, MAX_TILT + 1e-9),
     ((0.0, 0.0, -9.8), -MAX_TILT, MAX_TILT),       # at the limit: good
     (-9.8, 0.0, 0.0),                              # f_z only
+    (np.float64(-9.8), 0.02, 0.0),                 # f_z as numpy's float
+    (np.array([-9.8]), 0.0, 0.0),
+    (-199.5, 0.0, 0.0),                            # f_z beyond the float margin
+    (1e12, 0.0, 0.0),
+    (math.nan, 0.0, 0.0),
+    (-math.inf, 0.0, 0.0),
+    (-9.8, math.nan, 0.0),
+    (-9.8, 0.0, MAX_TILT + 1e-9),
+    (-10, 0.0, 0.0),                               # an int
     ((1.0, 2.0), 0.0, 0.0),                        # a bad shape
 ])
 def test_the_float_check_agrees_with_the_array_check(acc, roll, pitch):
@@ -32,6 +43,17 @@ def test_the_float_check_agrees_with_the_array_check(acc, roll, pitch):
     assert warning == _bad_sample(full, float(roll), float(pitch))
     np.testing.assert_array_equal(np.asarray(f, dtype=float), full)
     assert (r, p) == (float(roll), float(pitch)) and type(r) is float
+
+
+def test_before_its_first_model_the_bank_answers_invalid_and_says_why_a_sample_was_bad():
+    bank = OscillatorBankHeave(HeaveObserverParams(model="band", window=60.0), quiet=True)
+    first = bank.step((0.0, 0.0, -9.8), 0.01, 0.0, 0.01)
+    assert not first.valid and first.warning is None and first.modes == 0 and first.heave == 0.0
+    bad = bank.step((math.nan, 0.0, -9.8), 0.01, 0.0, 0.01)
+    assert not bad.valid and bad.warning == "non-finite acceleration or angle sample"
+    assert bad == first.__class__(**{**first.__dict__, "warning": bad.warning})
+    assert bank.step(-9.8, 0.01, 0.0, 0.01) == first
+    assert bank.model is None and bank.k == 3
 
 
 def test_the_angle_ring_round_trips_through_json():

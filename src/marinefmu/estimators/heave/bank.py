@@ -144,6 +144,8 @@ class OscillatorBankHeave:
             if self.k >= self.next_detect and self._detect():
                 self._replay()
                 return self._finish(good and restarted is None, warning)
+            if warning is None:   # the initial result (frozen, not valid) is the answer as it stands
+                return self._result
             return replace(self._result, valid=False, warning=warning)
         self._process(a_v, aux)
         self._buffer(a_v, roll, pitch)

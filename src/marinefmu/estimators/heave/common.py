@@ -320,12 +320,14 @@ def central_rate(prev: tuple[float, float], nxt: tuple[float, float], dt: float)
 def read_sample(acc: Any, roll: float, pitch: float) -> tuple[Any, float, float, str | None]:
     """One IMU sample as the heave estimators take it: (f_b (3,) [m/s²], roll, pitch [rad],
     the reason it is bad or None). ``acc`` is f_z or (3,) f_b; another shape is a bad sample.
-    A (3,) sequence or array whose values are finite and well inside the limits is checked on
-    Python floats and returned as a tuple of them (NaN fails every comparison, so it takes
-    the full check); anything else as an array, after the full check."""
+    A float f_z (taken as (0, 0, f_z)) or a (3,) sequence or array whose values are finite and
+    well inside the limits is checked on Python floats and returned as a tuple of them (NaN
+    fails every comparison, so it takes the full check); anything else as an array, after the
+    full check."""
     roll, pitch = float(roll), float(pitch)
-    if (type(acc) in (tuple, list) and len(acc) == 3) or (isinstance(acc, np.ndarray) and acc.shape == (3,)):
-        fx, fy, fz = float(acc[0]), float(acc[1]), float(acc[2])
+    three = (type(acc) in (tuple, list) and len(acc) == 3) or (isinstance(acc, np.ndarray) and acc.shape == (3,))
+    if three or isinstance(acc, float):   # np.float64 is a float
+        fx, fy, fz = (float(acc[0]), float(acc[1]), float(acc[2])) if three else (0.0, 0.0, float(acc))
         if abs(roll) <= MAX_TILT and abs(pitch) <= MAX_TILT and fx * fx + fy * fy + fz * fz <= _FORCE_PASS2:
             return (fx, fy, fz), roll, pitch, None
         f = np.array((fx, fy, fz))
