@@ -502,6 +502,7 @@ class WienerGroup:
         self.sums = np.zeros((len(self.axes), 0))
         self._designs: list[np.ndarray | None] = []       # the taps the stack below was built from
         self._taps = np.zeros((len(self.axes), 4, 0))
+        self._node_taps = np.zeros((len(self.axes), 4, 1))
         self._offsets = np.zeros((len(self.axes), 4))     # mean × the taps' sums, per axis
 
     def bind(self) -> None:
@@ -538,15 +539,24 @@ class WienerGroup:
                 return None
             self._stack_taps()
         nodes = axes[0].nodes(self.sums, self._taps.shape[2])
-        blocks = nodes[:, :-1] - nodes[:, 1:]
-        return np.matmul(self._taps, blocks[:, :, None])[:, :, 0] - self._offsets
+        return np.matmul(self._node_taps, nodes[:, :, None])[:, :, 0] - self._offsets
 
     def _stack_taps(self) -> None:
-        """The axes' current taps, zero-padded to the longest, and their mean terms."""
+        """The axes' current taps, zero-padded to the longest, their differences and their mean
+        terms.
+
+        A block's sum is the difference of two neighbouring nodes n_j, so the taps h_j act on
+        the nodes as d_j = h_j − h_{j−1} (h_{−1} = h_L = 0): Σ_j h_j (n_j − n_{j+1}) =
+        Σ_j d_j n_j, one product on the L + 1 nodes and no subtraction of L columns. The
+        d_j sum to zero, so the nodes' common part (the running sum's level) cancels as it
+        did in the differences, to the same rounding."""
         longest = max(a.taps.shape[1] for a in self.axes)
         self._taps = np.zeros((len(self.axes), 4, longest))
         for row, axis in zip(self._taps, self.axes):
             row[:, :axis.taps.shape[1]] = axis.taps
+        padded = np.zeros((len(self.axes), 4, longest + 2))
+        padded[:, :, 1:-1] = self._taps
+        self._node_taps = np.diff(padded, axis=2)       # (A, 4, L + 1): d_j = h_j − h_{j−1}
         self._offsets = np.array([a.mean * a.tap_sums for a in self.axes])
         self._designs = [a.taps for a in self.axes]
 
