@@ -17,6 +17,12 @@ MAX_TILT = math.radians(80.0)
 MAX_YAW = 1e4
 
 
+#: Squared specific force [m²/s⁴] below which a sample passes on float comparisons alone, a
+#: margin inside :data:`MAX_SPECIFIC_FORCE` (the full check's norm rounds differently). NaN
+#: fails every comparison, so a non-finite sample takes the full check.
+FORCE_PASS2 = (0.99 * MAX_SPECIFIC_FORCE) ** 2
+
+
 def force_beyond_limit(acc: np.ndarray) -> str | None:
     """Reason if the finite specific force ``acc`` [m/s²] exceeds :data:`MAX_SPECIFIC_FORCE`."""
     return f"specific force beyond {MAX_SPECIFIC_FORCE} m/s²" if math.sqrt(acc @ acc) > MAX_SPECIFIC_FORCE else None

@@ -246,7 +246,8 @@ def test_the_output_variance_on_its_two_blocks_is_the_full_product_and_the_step_
     it must equal diag(M J Mᵀ) with the whole output map M (:meth:`FusionError.output_map`) to
     rounding (1e-12 relative; the other columns of M are zeros). The step's output reuses the
     rotation of its propagated attitude unless a fix has turned the attitude since: the output
-    must equal one made from the attitude as it stands, on fix steps and between them."""
+    must equal one made from the attitude as it stands, on fix steps and between them, and
+    the output's floats their numpy forms."""
     rec = paper001.simulate(60.0, {"gnss.rate": 1.0, "sea.seed": 2, "sensors.seed": 2})
     est = GnssAccFusion(paper001.params())
     assert np.linalg.norm(est.error.acc_arm) > 0.5          # the attitude block matters
@@ -260,8 +261,17 @@ def test_the_output_variance_on_its_two_blocks_is_the_full_product_and_the_step_
         m = est.error.output_map(rot)
         full = np.einsum("ij,jk,ik->i", m, est.error.joint, m)
         np.testing.assert_allclose(est.error.position_var(rot), full, rtol=1e-12, atol=0.0)
-        again = est._result(r.fix, r.valid, r.warning, np.asarray(rec["gyro"][k], dtype=float))
+        arm = rot @ est.error.acc_arm
+        assert est.error.position_var(rot, tuple(arm.tolist())) == est.error.position_var(rot)
+        w = np.asarray(rec["gyro"][k], dtype=float)
+        again = est._result(r.fix, r.valid, r.warning, w)
         assert again.pos == r.pos and again.vel == r.vel and again.pos_std == r.pos_std
+        # the output on floats against its numpy form: x − R̂ l, v − R̂ ((ω − b) × l), √var
+        x = est.kf.x.ravel()
+        np.testing.assert_allclose(r.pos, x[:3] - arm, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(r.vel, x[3:6] - rot @ np.cross(w - est.gyro_bias, est.error.acc_arm), rtol=0, atol=1e-14)
+        if est.coast_var is None:
+            np.testing.assert_allclose(r.pos_std, np.sqrt(full), rtol=1e-12, atol=0)
         fixes += bool(r.fix)
         checked += 1
     assert fixes >= 40 and checked >= 600, (fixes, checked)

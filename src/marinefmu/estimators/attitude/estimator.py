@@ -96,7 +96,7 @@ import numpy as np
 from ...errors import check_choice, check_int, check_range, check_vector
 from ...frames import euler_to_quat, half_angle_coefficients, level_angles, quat_mul, quat_to_euler
 from ..noise_meter import WhiteNoiseMeter
-from ..samples import MAX_RATE, MAX_SPECIFIC_FORCE, force_beyond_limit, rate_beyond_limit
+from ..samples import FORCE_PASS2, MAX_RATE, force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
 
@@ -297,11 +297,6 @@ def _bad_sample(gyro: np.ndarray, acc: np.ndarray) -> str | None:
     return rate_beyond_limit(gyro) or force_beyond_limit(acc)
 
 
-#: Squared specific force [m²/s⁴] below which a finite sample passes without the full check
-#: (a margin inside :data:`~marinefmu.estimators.samples.MAX_SPECIFIC_FORCE`).
-_FORCE_PASS2 = (0.99 * MAX_SPECIFIC_FORCE) ** 2
-
-
 class ErrorStateFilter:
     """The arrays of the error-state Kalman filter: ``x`` (8, 1), zero between steps (each
     update is injected into the nominal state and reset), ``P`` (8, 8) and ``R`` (4, 4)."""
@@ -429,7 +424,7 @@ class AttitudeEstimator:
         gx, gy, gz, ax, ay, az = float(gx), float(gy), float(gz), float(ax), float(ay), float(az)
         # NaN fails every comparison, so a non-finite sample takes the full check too
         if (-MAX_RATE <= gx <= MAX_RATE and -MAX_RATE <= gy <= MAX_RATE and -MAX_RATE <= gz <= MAX_RATE
-                and ax * ax + ay * ay + az * az <= _FORCE_PASS2):
+                and ax * ax + ay * ay + az * az <= FORCE_PASS2):
             warning = None
         else:
             warning = _bad_sample(np.array((gx, gy, gz)), np.array((ax, ay, az)))

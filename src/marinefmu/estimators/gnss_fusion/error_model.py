@@ -382,21 +382,28 @@ class FusionError:
         m[:, nx:nx + 3] = -skew(rot @ self.acc_arm)
         return m
 
-    def position_var(self, rot: np.ndarray) -> np.ndarray:
-        """Variance of the COG output per NED axis [m²] (``rot`` the attitude R_nb used).
+    def position_var(self, rot: np.ndarray, arm_n: tuple[float, float, float] | None = None) -> tuple[float, float, float]:
+        """Variance of the COG output per NED axis [m²] (``rot`` the attitude R_nb used;
+        ``arm_n``: R̂ l [m, NED] when the caller has it).
 
         diag(M J Mᵀ) with M = [I 0 A 0] of :meth:`output_map`, A = −[R̂ l]×, written on the
-        two 3 × 3 blocks M touches (position p and attitude ε; J symmetric):
-        var_i = J_pp,ii + 2 Σ_k A_ik J_pε,ik + (A J_εε Aᵀ)_ii. Called every step; the full
-        product would multiply the other states' zero columns too."""
+        two 3 × 3 blocks M touches (position p and attitude ε): with r = R̂ l, row i of A is
+        r × e_i, so var_i = J_pp,ii + 2 Σ_k A_ik J_pε,ik + Σ_jk A_ij J_εε,jk A_ik. Called
+        every step, on Python floats: the nine products of a row are fewer operations than a
+        numpy call's overhead (a test checks it against the full product)."""
         if self.joint is None:
-            return np.zeros(3)
+            return (0.0, 0.0, 0.0)
         nx = len(self.joint) - 9
-        a = -skew(rot @ self.acc_arm)
         j = self.joint
-        var = (np.diagonal(j)[:3] + 2.0 * np.einsum("ik,ik->i", j[:3, nx:nx + 3], a)
-               + np.einsum("ij,jk,ik->i", a, j[nx:nx + 3, nx:nx + 3], a))
-        return np.maximum(var, 0.0)   # rounding: never negative
+        r0, r1, r2 = (rot @ self.acc_arm).tolist() if arm_n is None else arm_n
+        (c00, c01, c02), (c10, c11, c12), (c20, c21, c22) = j[:3, nx:nx + 3].tolist()       # J_pε
+        (e00, e01, e02), (e10, e11, e12), (e20, e21, e22) = j[nx:nx + 3, nx:nx + 3].tolist()  # J_εε
+        d0, d1, d2 = j.diagonal()[:3].tolist()
+        # rows of A: (0, r2, −r1), (−r2, 0, r0), (r1, −r0, 0)
+        var0 = d0 + 2.0 * (r2 * c01 - r1 * c02) + r2 * r2 * e11 - r2 * r1 * (e12 + e21) + r1 * r1 * e22
+        var1 = d1 + 2.0 * (r0 * c12 - r2 * c10) + r2 * r2 * e00 - r2 * r0 * (e02 + e20) + r0 * r0 * e22
+        var2 = d2 + 2.0 * (r1 * c20 - r0 * c21) + r1 * r1 * e00 - r1 * r0 * (e01 + e10) + r0 * r0 * e11
+        return max(var0, 0.0), max(var1, 0.0), max(var2, 0.0)   # rounding: never negative
 
     # ---- state -------------------------------------------------------------------------------
     def get_state(self) -> dict:

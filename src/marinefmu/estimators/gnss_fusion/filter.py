@@ -119,8 +119,8 @@ from filterpy.kalman import KalmanFilter
 from scipy.spatial.transform import Rotation
 
 from ...errors import ParameterError, check_choice, check_range, check_vector
-from ...frames import GRAVITY_N, cross3, euler_to_quat, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
-from ..samples import angles_beyond_limit, force_beyond_limit, rate_beyond_limit
+from ...frames import GRAVITY_N, cross3, euler_to_quat, floats, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
+from ..samples import FORCE_PASS2, MAX_RATE, angles_beyond_limit, force_beyond_limit
 from .antenna_attitude import (ANTENNAS, DEFAULT_ANTENNAS, MIN_SPREAD, AntennaFix, antenna_attitude, antenna_attitude_std,
                                matrix_rotvec)
 from .error_model import FusionError, pi_gains, skew
@@ -431,11 +431,30 @@ class GnssAccFusionResult:
     warning: str | None = None
 
 
+def force_sample_good(f: np.ndarray) -> bool:
+    """The (3,) specific force ``f`` [m/s²] is finite and within
+    :data:`~marinefmu.estimators.samples.MAX_SPECIFIC_FORCE`: on Python floats inside the
+    margin of :data:`~marinefmu.estimators.samples.FORCE_PASS2`, else by the full check."""
+    f0, f1, f2 = f.tolist()
+    if f0 * f0 + f1 * f1 + f2 * f2 <= FORCE_PASS2:
+        return True
+    return bool(np.all(np.isfinite(f))) and force_beyond_limit(f) is None
+
+
+def rate_sample_good(w: np.ndarray) -> bool:
+    """The (3,) angular rate ``w`` [rad/s] is finite and each component within ±
+    :data:`~marinefmu.estimators.samples.MAX_RATE` (float comparisons: exact, and NaN fails
+    them)."""
+    w0, w1, w2 = w.tolist()
+    return -MAX_RATE <= w0 <= MAX_RATE and -MAX_RATE <= w1 <= MAX_RATE and -MAX_RATE <= w2 <= MAX_RATE
+
+
 def propagate(q: np.ndarray, rate: np.ndarray, dt: float) -> np.ndarray:
     """Attitude quaternion R_nb (scalar first) turned by the body rate ``rate`` [rad/s] over
     ``dt`` s (exact rotation), normalised."""
-    q = quat_mul(q, quat_from_rotvec(rate * dt))
-    return q / np.linalg.norm(q)
+    r0, r1, r2 = floats(rate)
+    q = quat_mul(q, quat_from_rotvec((r0 * dt, r1 * dt, r2 * dt)))
+    return q / math.sqrt(q.dot(q))      # np.linalg.norm's own sum, without its dispatch
 
 
 def pi_pull(q: np.ndarray, bias: np.ndarray, rot_fix: np.ndarray, dt_fix: float, tau: float,
@@ -667,7 +686,7 @@ class GnssAccFusion:
         if self.params.attitude_lag == 0.0 or gyro is None:
             return None
         w = np.asarray(gyro, dtype=float).reshape(3)
-        if not (np.all(np.isfinite(w)) and rate_beyond_limit(w) is None):
+        if not rate_sample_good(w):
             w = self.last_gyro     # a bad sample: the step's warning comes from the filter
         if w is None or self.params.step_input == "latest" or self.last_gyro is None:
             return w
@@ -694,13 +713,13 @@ class GnssAccFusion:
         p = self.run_params
         warning = None
         f_b = np.asarray(acc, dtype=float).reshape(3)
-        good = bad is None and bool(np.all(np.isfinite(f_b))) and force_beyond_limit(f_b) is None
+        good = bad is None and force_sample_good(f_b)
         if not good:
             warning = bad or "bad accelerometer sample (NaN/Inf/absurd): coasting on the last good one"
             f_b = self.last_acc
         self.last_acc = f_b
         w = None if gyro is None else np.asarray(gyro, dtype=float).reshape(3)
-        if w is not None and not (np.all(np.isfinite(w)) and rate_beyond_limit(w) is None):
+        if w is not None and not rate_sample_good(w):
             warning = warning or "bad gyro sample (NaN/Inf/absurd): holding the last good rate"
             good = False
             w = self.last_gyro
@@ -956,24 +975,33 @@ class GnssAccFusion:
 
     def _result(self, fix: str, valid: bool, warning: str | None, w: np.ndarray | None,
                 rot: np.ndarray | None = None) -> GnssAccFusionResult:
-        """The step's output; ``rot``: R_nb of the current ``q`` when already computed."""
+        """The step's output; ``rot``: R_nb of the current ``q`` when already computed. On
+        Python floats (every step; a 3 × 3 product is fewer operations than a numpy call's
+        overhead): pos = x − R̂ l, vel = v − R̂ ((ω − b) × l)."""
         p = self.run_params
         rot = quat_to_rot(self.q) if rot is None else rot
-        x = self.kf.x.ravel()
-        arm = rot @ np.asarray(p.acc_lever_arm)
-        pos = x[:3] - arm if self.initialised else np.zeros(3)
-        vel = x[3:6].copy()
-        if w is not None and self.initialised:
-            vel -= rot @ cross3(w - self.gyro_bias, p.acc_lever_arm)
-        if self.coast_var is None:     # the error as the filter runs (error_model)
-            var = self.error.position_var(rot)
-        else:   # in a gap: the coast's own, and how far the output strays from it (module docstring)
-            var = self.coast_var + self.coast_track
-        std = np.sqrt(var) if self.initialised else np.zeros(3)  # valid is False then
-        bias = x[6:9] if p.bias_states else np.zeros(3)
-        euler = quat_to_euler(self.q)
-        return GnssAccFusionResult(tuple(pos.tolist()), tuple(vel.tolist()), tuple(std.tolist()), tuple(euler),
-                            tuple(self.acc_n.tolist()), tuple(bias.tolist()), self.residual, fix, valid, warning)
+        x = self.kf.x.ravel().tolist()
+        (a, b, c), (d, e, f), (g, h, i) = rot.tolist()
+        l0, l1, l2 = p.acc_lever_arm
+        arm = (a * l0 + b * l1 + c * l2, d * l0 + e * l1 + f * l2, g * l0 + h * l1 + i * l2)
+        vel = (x[3], x[4], x[5])
+        if self.initialised:
+            pos = (x[0] - arm[0], x[1] - arm[1], x[2] - arm[2])
+            if w is not None:
+                u0, u1, u2 = (w - self.gyro_bias).tolist()
+                k0, k1, k2 = u1 * l2 - u2 * l1, u2 * l0 - u0 * l2, u0 * l1 - u1 * l0     # (ω − b) × l
+                vel = (vel[0] - (a * k0 + b * k1 + c * k2), vel[1] - (d * k0 + e * k1 + f * k2),
+                       vel[2] - (g * k0 + h * k1 + i * k2))
+            if self.coast_var is None:     # the error as the filter runs (error_model)
+                var = self.error.position_var(rot, arm)
+            else:   # in a gap: the coast's own, and how far the output strays from it (module docstring)
+                var = (self.coast_var + self.coast_track).tolist()
+            std = (math.sqrt(var[0]), math.sqrt(var[1]), math.sqrt(var[2]))
+        else:                              # valid is False then
+            pos = std = (0.0, 0.0, 0.0)
+        bias = (x[6], x[7], x[8]) if p.bias_states else (0.0, 0.0, 0.0)
+        return GnssAccFusionResult(pos, vel, std, quat_to_euler(self.q), tuple(self.acc_n.tolist()), bias,
+                                   self.residual, fix, valid, warning)
 
     # ---- FMU state ---------------------------------------------------------------------------
     def get_state(self) -> dict:

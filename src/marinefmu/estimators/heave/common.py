@@ -62,11 +62,7 @@ from ...errors import check_choice, check_int, check_range, check_vector
 from ...frames import G
 from .band_bank import BAND_VARIANCES
 from .oscillator_bank import DISCRETISATIONS, MEASUREMENTS
-from ..samples import MAX_SPECIFIC_FORCE, MAX_TILT, angles_beyond_limit, force_beyond_limit
-
-#: Squared specific force [m²/s⁴] below which a finite sample passes :func:`read_sample` on float
-#: comparisons alone (a margin inside :data:`~marinefmu.estimators.samples.MAX_SPECIFIC_FORCE`).
-_FORCE_PASS2 = (0.99 * MAX_SPECIFIC_FORCE) ** 2
+from ..samples import FORCE_PASS2, MAX_TILT, angles_beyond_limit, force_beyond_limit
 
 
 class SilentLog:
@@ -328,7 +324,7 @@ def read_sample(acc: Any, roll: float, pitch: float) -> tuple[Any, float, float,
     three = (type(acc) in (tuple, list) and len(acc) == 3) or (isinstance(acc, np.ndarray) and acc.shape == (3,))
     if three or isinstance(acc, float):   # np.float64 is a float
         fx, fy, fz = (float(acc[0]), float(acc[1]), float(acc[2])) if three else (0.0, 0.0, float(acc))
-        if abs(roll) <= MAX_TILT and abs(pitch) <= MAX_TILT and fx * fx + fy * fy + fz * fz <= _FORCE_PASS2:
+        if abs(roll) <= MAX_TILT and abs(pitch) <= MAX_TILT and fx * fx + fy * fy + fz * fz <= FORCE_PASS2:
             return (fx, fy, fz), roll, pitch, None
         f = np.array((fx, fy, fz))
     else:
