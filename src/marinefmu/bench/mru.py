@@ -152,6 +152,38 @@ def print_mru(rows: list[dict]) -> dict:
     return {"over_goal": over, "delayed_over": delayed_over, "n_cases": len(rows)}
 
 
+def filter_feed(gyro: np.ndarray, acc: np.ndarray,
+                params: MotionReferenceUnitParams) -> tuple[list[list[float | None]], list[np.ndarray | None]]:
+    """What a MotionReferenceUnit run over the IMU samples ``gyro``, ``acc`` (N, 3) gives its
+    motion filters (:class:`~marinefmu.estimators.heave.wiener.WienerGroup`) step by step, the
+    level-frame accelerations and, with points, the yaw rate, and what they return (copies)."""
+    unit = MotionReferenceUnit(params, quiet=True)
+    fed: list[list[float | None]] = []
+    got: list[np.ndarray | None] = []
+    for k in range(len(acc)):
+        if k == 0:
+            unit.start(DT)
+            push = unit.group.push
+
+            def recorded(values, push=push):
+                out = push(values)
+                fed.append(list(values))
+                got.append(None if out is None else out.copy())
+                return out
+
+            unit.group.push = recorded
+        unit.step(gyro[k], acc[k], DT)
+    return fed, got
+
+
+def replay_filters(fed: list[list[float | None]], params: MotionReferenceUnitParams) -> list[np.ndarray | None]:
+    """The unit's motion filters, fresh, fed ``fed`` (:func:`filter_feed`): their outputs."""
+    unit = MotionReferenceUnit(params, quiet=True)
+    unit.start(DT)
+    push = unit.group.push
+    return [push(values) for values in fed]
+
+
 def cost_per_step(steps: int = 30000) -> dict[str, float]:
     """In-process µs per step of the MotionReferenceUnit with the four :data:`POINTS` and with
     none, the AttitudeEstimator and the HeaveObserver at their defaults, on the first case's
@@ -161,7 +193,13 @@ def cost_per_step(steps: int = 30000) -> dict[str, float]:
     The budget is the AttitudeEstimator's plus 1.5 × the HeaveObserver's. The unit without
     points is what the budget compares: the attitude and the motion at the IMU (three axis
     filters; the yaw filter serves the points only). ``points_us``, the difference, is what the
-    points' lever arms add (their rates, accelerations and the delayed arm)."""
+    points' lever arms add (their rates, accelerations and the delayed arm).
+
+    The floor, ``floor_us``, is what no arrangement of the unit's own code can save: its
+    AttitudeEstimator's step plus its three axis filters' (``filters_us``: the same
+    :class:`~marinefmu.estimators.heave.wiener.WienerGroup`, fresh, replayed on the values the
+    unit gave it, :func:`replay_filters`; designs and bias-step searches included). The unit
+    without points costs that plus its level frame and its outputs."""
     import time
 
     from ..estimators.attitude.estimator import AttitudeEstimator
@@ -178,6 +216,14 @@ def cost_per_step(steps: int = 30000) -> dict[str, float]:
               "mru_no_points_us": (lambda: MotionReferenceUnit(quiet=True), imu_step),
               "attitude_us": (AttitudeEstimator, imu_step),
               "heave_us": (lambda: HeaveObserver(quiet=True), lambda m, k: m.step(acc[k], roll[k], pitch[k], DT))}
+    fed, _ = filter_feed(gyro, acc, MotionReferenceUnitParams())
+
+    def fresh_filters():
+        unit = MotionReferenceUnit(quiet=True)
+        unit.start(DT)
+        return unit.group
+
+    models["filters_us"] = (fresh_filters, lambda group, k: group.push(fed[k]))
     best = dict.fromkeys(models, math.inf)
     for _ in range(2):
         for name, (make, run) in models.items():
@@ -187,6 +233,7 @@ def cost_per_step(steps: int = 30000) -> dict[str, float]:
                 run(model, k)
             best[name] = min(best[name], 1e6 * (time.perf_counter() - t) / steps)
     return {**best, "points_us": best["mru_us"] - best["mru_no_points_us"],
+            "floor_us": best["attitude_us"] + best["filters_us"],
             "budget_us": best["attitude_us"] + 1.5 * best["heave_us"]}
 
 
@@ -222,7 +269,8 @@ def mru_bench(progress: bool = True) -> dict:
     cost = cost_per_step()
     print(f"cost per step in-process: MotionReferenceUnit (4 points) {cost['mru_us']:.1f} us, without points "
           f"{cost['mru_no_points_us']:.1f} us; budget {cost['budget_us']:.1f} us = AttitudeEstimator "
-          f"{cost['attitude_us']:.1f} + 1.5 x HeaveObserver {cost['heave_us']:.1f}")
+          f"{cost['attitude_us']:.1f} + 1.5 x HeaveObserver {cost['heave_us']:.1f}; floor {cost['floor_us']:.1f} us "
+          f"= the attitude + its three axis filters {cost['filters_us']:.1f}")
     return {"cases": rows, **summary, "mru_grade": mru_rows, "cost": cost}
 
 
