@@ -235,23 +235,27 @@ class MotionReferenceUnit:
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros.copy(), np.zeros(rows), zeros.copy(),
                              self.delay, heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
         o = out[:3, :3].T                          # (3, 3 axes): position, rate, delayed position
+        if not points:                             # the IMU's row only: views of this step's own outputs
+            motion = o[:, None, :]
+            return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], np.array([self.heave_acc]),
+                             motion[2], self.delay, heave_axis.peak_period, angles_valid, good,
+                             good and self.k * dt >= self.delayed_from, heading_used, warning)
         motion = np.empty((3, rows, 3))            # position, velocity, delayed position: IMU, then points
         motion[:, 0] = o
         heave_acc = np.empty(rows)
         heave_acc[0] = self.heave_acc
-        if points:
-            w = self.weights.shape[1]
-            j = (self.k - 1) % n                   # the newest sample's row
-            terms = self.terms
-            terms[0] = ring[j]
-            if self.k >= w:
-                np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1:3])   # oldest first
-            else:
-                terms[1:3] = 0.0
-            terms[3] = ring[(self.k - 1 - self.lag_steps) % n]
-            at = (terms @ self.turn_map_t).reshape(4, points, 3)      # d, ḋ, d̈ and the delayed d per point
-            np.add(o[:, None, :], at[[0, 1, 3]], out=motion[:, 1:])
-            np.add(self.heave_acc, at[2, :, 2], out=heave_acc[1:])
+        w = self.weights.shape[1]
+        j = (self.k - 1) % n                   # the newest sample's row
+        terms = self.terms
+        terms[0] = ring[j]
+        if self.k >= w:
+            np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1:3])   # oldest first
+        else:
+            terms[1:3] = 0.0
+        terms[3] = ring[(self.k - 1 - self.lag_steps) % n]
+        at = (terms @ self.turn_map_t).reshape(4, points, 3)      # d, ḋ, d̈ and the delayed d per point
+        np.add(o[:, None, :], at[[0, 1, 3]], out=motion[:, 1:])
+        np.add(self.heave_acc, at[2, :, 2], out=heave_acc[1:])
         return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], heave_acc, motion[2], self.delay,
                          heave_axis.peak_period, angles_valid, good, good and self.k * dt >= self.delayed_from,
                          heading_used, warning)
