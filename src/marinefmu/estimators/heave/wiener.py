@@ -538,7 +538,9 @@ class WienerGroup:
             if any(a.taps is None for a in axes):
                 return None
             self._stack_taps()
-        nodes = axes[0].nodes(self.sums, self._taps.shape[2])
+        # the strided nodes copied together first: matmul on the strided view is slower than
+        # the copy and a contiguous product
+        nodes = np.ascontiguousarray(axes[0].nodes(self.sums, self._taps.shape[2]))
         return np.matmul(self._node_taps, nodes[:, :, None])[:, :, 0] - self._offsets
 
     def _stack_taps(self) -> None:
