@@ -160,18 +160,17 @@ def filter_feed(gyro: np.ndarray, acc: np.ndarray,
     unit = MotionReferenceUnit(params, quiet=True)
     fed: list[list[float | None]] = []
     got: list[np.ndarray | None] = []
+    unit.start(DT)
+    push = unit.group.push
+
+    def recorded(values):
+        out = push(values)
+        fed.append(list(values))
+        got.append(None if out is None else out.copy())
+        return out
+
+    unit.group.push = recorded
     for k in range(len(acc)):
-        if k == 0:
-            unit.start(DT)
-            push = unit.group.push
-
-            def recorded(values, push=push):
-                out = push(values)
-                fed.append(list(values))
-                got.append(None if out is None else out.copy())
-                return out
-
-            unit.group.push = recorded
         unit.step(gyro[k], acc[k], DT)
     return fed, got
 

@@ -33,6 +33,24 @@ def rate_beyond_limit(gyro: np.ndarray) -> str | None:
     return f"gyro sample beyond ±{MAX_RATE} rad/s" if np.max(np.abs(gyro)) > MAX_RATE else None
 
 
+def force_sample_good(f: np.ndarray) -> bool:
+    """The (3,) specific force ``f`` [m/s²] is finite and within
+    :data:`MAX_SPECIFIC_FORCE`: on Python floats inside the
+    margin of :data:`FORCE_PASS2`, else by the full check."""
+    f0, f1, f2 = f.tolist()
+    if f0 * f0 + f1 * f1 + f2 * f2 <= FORCE_PASS2:
+        return True
+    return bool(np.all(np.isfinite(f))) and force_beyond_limit(f) is None
+
+
+def rate_sample_good(w: np.ndarray) -> bool:
+    """The (3,) angular rate ``w`` [rad/s] is finite and each component within ±
+    :data:`MAX_RATE` (float comparisons: exact, and NaN fails
+    them)."""
+    w0, w1, w2 = w.tolist()
+    return -MAX_RATE <= w0 <= MAX_RATE and -MAX_RATE <= w1 <= MAX_RATE and -MAX_RATE <= w2 <= MAX_RATE
+
+
 def angles_beyond_limit(euler: np.ndarray) -> str | None:
     """Reason if finite (roll, pitch[, yaw]) ``euler`` [rad] exceed :data:`MAX_TILT` / :data:`MAX_YAW`."""
     if max(abs(euler[0]), abs(euler[1])) > MAX_TILT:

@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from marinefmu.estimators.gnss_fusion.filter import force_sample_good, rate_sample_good
-from marinefmu.estimators.samples import MAX_RATE, MAX_SPECIFIC_FORCE, force_beyond_limit, rate_beyond_limit
+from marinefmu.estimators.samples import (MAX_RATE, MAX_SPECIFIC_FORCE, force_beyond_limit, force_sample_good,
+                                         rate_beyond_limit, rate_sample_good)
 
 EDGES = [0.0, -9.8, 0.99 * MAX_SPECIFIC_FORCE, 0.999 * MAX_SPECIFIC_FORCE, MAX_SPECIFIC_FORCE,
          MAX_SPECIFIC_FORCE * (1 + 1e-15), 1e12, math.nan, math.inf, -math.inf]

@@ -120,7 +120,7 @@ from scipy.spatial.transform import Rotation
 
 from ...errors import ParameterError, check_choice, check_range, check_vector
 from ...frames import GRAVITY_N, cross3, euler_to_quat, floats, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
-from ..samples import FORCE_PASS2, MAX_RATE, angles_beyond_limit, force_beyond_limit
+from ..samples import angles_beyond_limit, force_beyond_limit, force_sample_good, rate_sample_good
 from .antenna_attitude import (ANTENNAS, DEFAULT_ANTENNAS, MIN_SPREAD, AntennaFix, antenna_attitude, antenna_attitude_std,
                                matrix_rotvec)
 from .error_model import FusionError, pi_gains, skew
@@ -429,24 +429,6 @@ class GnssAccFusionResult:
     fix: str
     valid: bool
     warning: str | None = None
-
-
-def force_sample_good(f: np.ndarray) -> bool:
-    """The (3,) specific force ``f`` [m/s²] is finite and within
-    :data:`~marinefmu.estimators.samples.MAX_SPECIFIC_FORCE`: on Python floats inside the
-    margin of :data:`~marinefmu.estimators.samples.FORCE_PASS2`, else by the full check."""
-    f0, f1, f2 = f.tolist()
-    if f0 * f0 + f1 * f1 + f2 * f2 <= FORCE_PASS2:
-        return True
-    return bool(np.all(np.isfinite(f))) and force_beyond_limit(f) is None
-
-
-def rate_sample_good(w: np.ndarray) -> bool:
-    """The (3,) angular rate ``w`` [rad/s] is finite and each component within ±
-    :data:`~marinefmu.estimators.samples.MAX_RATE` (float comparisons: exact, and NaN fails
-    them)."""
-    w0, w1, w2 = w.tolist()
-    return -MAX_RATE <= w0 <= MAX_RATE and -MAX_RATE <= w1 <= MAX_RATE and -MAX_RATE <= w2 <= MAX_RATE
 
 
 def propagate(q: np.ndarray, rate: np.ndarray, dt: float) -> np.ndarray:
