@@ -131,3 +131,51 @@ def test_heave_observer_fed_by_vessel_motion_in_libcosim(fmu_dir):
         y = m.step(k * dt + dt, dt)
     np.testing.assert_allclose(got, [r.heave, r.heave_rate, r.point_heave, r.offset], rtol=1e-7, atol=1e-9)
     assert valid and r.valid and 0.01 < abs(r.heave) < 3.0
+
+
+def _affinities() -> dict[int, set[int]]:
+    import os
+
+    return {int(t): os.sched_getaffinity(int(t)) for t in os.listdir("/proc/self/task")}
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "sched_setaffinity"), reason="no CPU affinity on this OS")
+def test_one_worker_gives_the_same_outputs_with_fewer_threads_and_pins_none(fmu_dir, tmp_path):
+    """``one_worker`` (VesselMotion wired to HeaveObserver, 5 s at 100 Hz): the outputs equal the
+    default pool's bit for bit (the same Jacobi steps), the execution starts no more threads
+    than the default one, and afterwards every thread of the process may run on every CPU it
+    could before: nothing is left pinned to the CPU the pool was made on."""
+    import os
+
+    from fmpy import read_model_description
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimObserver import CosimObserver
+
+    from marinefmu.cosim.libcosim import one_worker, write_osp_system
+    from marinefmu.cosim.ssp import Component, Connection, SystemDescription
+
+    system = SystemDescription("pair", (Component("vessel", "VesselMotion.fmu", {"sea.hs": 3.0}),
+                                        Component("heave", "HeaveObserver.fmu", {"window": 60.0})),
+                               tuple(Connection("vessel", f"imu.acc.{a}", "heave", f"acc.{a}") for a in "xyz")
+                               + (Connection("vessel", "truth.roll", "heave", "roll"),
+                                  Connection("vessel", "truth.pitch", "heave", "pitch")), step=0.01, stop_time=5.0)
+    path = str(write_osp_system(system, fmu_dir, tmp_path / "OspSystemStructure.xml"))
+    vr = {m: {v.name: v.valueReference for v in read_model_description(str(fmu_dir / f"{m}.fmu")).modelVariables}
+          for m in ("VesselMotion", "HeaveObserver")}
+    vessel_out = [vr["VesselMotion"][n] for n in ("truth.cog.d", "imu.acc.z", "truth.roll")]
+    heave_out = [vr["HeaveObserver"][n] for n in ("heave", "heave_rate", "offset")]
+    cpus = os.sched_getaffinity(0)
+    runs = {}
+    for how, make in (("default", lambda f: f()), ("one worker", one_worker)):
+        threads = set(_affinities())
+        ex = make(lambda: CosimExecution.from_osp_config_file(path))
+        started = set(_affinities()) - threads
+        obs = CosimObserver.create_last_value()
+        ex.add_observer(obs)
+        vessel, heave = ex.slave_index_from_instance_name("vessel"), ex.slave_index_from_instance_name("heave")
+        assert ex.simulate_until(500 * 10_000_000)
+        runs[how] = (len(started), obs.last_real_values(vessel, vessel_out), obs.last_real_values(heave, heave_out))
+        assert all(a == cpus for a in _affinities().values()), (how, _affinities(), cpus)
+    assert runs["one worker"][0] <= runs["default"][0]
+    assert runs["one worker"][1:] == runs["default"][1:]
+    assert any(v != 0.0 for v in runs["default"][1])          # the vessel moved: the comparison is not of zeros

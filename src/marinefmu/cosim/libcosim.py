@@ -9,12 +9,19 @@ receives the outputs all held at t, then all step, as :class:`~.system.SystemRun
 samples chosen variables with a last-value observer every ``sample_every`` s. Its result has the
 runner's layout (a ``time`` field and one ``component.variable`` field each), so the two engines
 compare field by field.
+
+:func:`one_worker` makes a libcosimpy execution whose fixed-step algorithm steps the simulators
+on one worker thread (the reason is in its docstring); :func:`run_libcosim` uses it, and a user
+who builds an execution with libcosimpy directly can too.
 """
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import os
+import threading
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -24,6 +31,57 @@ from .ssp import SystemDescription
 from .system_check import check_system, lookup
 
 NS = 1_000_000_000  # libcosim time unit: ns
+
+T = TypeVar("T")
+
+
+def _threads() -> set[int]:
+    """The native ids of this process's threads (Linux: ``/proc/self/task``); only the calling
+    thread's where that folder does not exist."""
+    try:
+        return {int(t) for t in os.listdir("/proc/self/task")}
+    except OSError:
+        return {threading.get_native_id()}
+
+
+def one_worker(create: Callable[[], T]) -> T:
+    """``create()``, a libcosimpy execution constructor (``CosimExecution.from_osp_config_file``,
+    ``from_step_size`` …), with libcosim's worker pool sized for one CPU.
+
+    libcosim's fixed-step algorithm hands each simulator's step to a pool of worker threads sized
+    from the CPUs the creating thread may run on, and waits for them. pythonfmu FMUs in one
+    process share one Python interpreter and its global interpreter lock, so those workers cannot
+    step two of them at once: what the pool adds is a hand-over between threads for every FMU at
+    every step, and on a busy machine each hand-over waits for the scheduler. Made for one CPU,
+    the pool steps the simulators one after the other without it, as the FMPy runner does; the
+    results are the same (the algorithm stays Jacobi: each simulator reads the outputs held at
+    t). What it saves is measured in ``docs/decisions/libcosim-one-worker.md``.
+
+    How: the calling thread is held to one of its CPUs while ``create`` runs, so that the pool is
+    made for one; then the calling thread and every thread ``create`` started get the calling
+    thread's former CPUs back, so nothing stays pinned. Where the operating system has no
+    ``sched_setaffinity`` (Windows, macOS) ``create()`` is called as it is.
+
+    Parameters
+    ----------
+    create : callable
+        Makes and returns the execution, e.g.
+        ``lambda: CosimExecution.from_osp_config_file(path)``.
+    """
+    if not hasattr(os, "sched_setaffinity"):
+        return create()
+    cpus = os.sched_getaffinity(0)
+    before = _threads()
+    os.sched_setaffinity(0, {min(cpus)})
+    try:
+        return create()
+    finally:
+        os.sched_setaffinity(0, cpus)
+        for tid in _threads() - before:
+            try:
+                os.sched_setaffinity(tid, cpus)
+            except OSError:          # a thread that ended meanwhile
+                pass
 
 
 def write_osp_system(system: SystemDescription, fmu_dir: str | Path, dest: str | Path) -> Path:
@@ -80,7 +138,7 @@ def run_libcosim(system: SystemDescription, fmu_dir: str | Path, work: str | Pat
             raise SystemError_(f"record {full!r}: only Real and Boolean variables can be sampled here, not {v.type}")
         wanted.append((full, comp, v))
     path = write_osp_system(system, fmu_dir, Path(work) / "OspSystemStructure.xml")
-    ex = CosimExecution.from_osp_config_file(str(path))
+    ex = one_worker(lambda: CosimExecution.from_osp_config_file(str(path)))
     obs = CosimObserver.create_last_value()
     ex.add_observer(obs)
     fields = [(full, ex.slave_index_from_instance_name(comp), v.type, v.valueReference) for full, comp, v in wanted]
