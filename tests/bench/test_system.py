@@ -46,6 +46,27 @@ def test_idle_fmus_have_the_variables_of_the_real_ones_and_do_nothing(fmu_dir, t
     r = SystemRunner(sysd, idle).run(record=["vessel.imu.gyro.x", "att.roll", "att.valid"], progress=False)
     assert r.size == 51
     assert np.all(r["vessel.imu.gyro.x"] == 0.0) and np.all(r["att.roll"] == 0.0) and not r["att.valid"].any()
+    # libcosim's floor (master_floor(engine="libcosim")) reads the OSP model descriptions beside them
+    assert all((idle / f"{m}_OspModelDescription.xml").exists() for m in ("VesselMotion", "AttitudeEstimator"))
+
+
+@pytest.mark.fmu
+@pytest.mark.libcosim
+@pytest.mark.isolated
+def test_the_idle_fmus_run_under_libcosim_as_run_libcosim_runs_them(fmu_dir, tmp_path):
+    """libcosim's floor: the idle VesselMotion wired to the idle AttitudeEstimator under
+    run_libcosim, 1 s sampled every 0.1 s, every output at its start value."""
+    from marinefmu.bench.system import idle_fmus
+    from marinefmu.cosim.libcosim import run_libcosim
+    from marinefmu.cosim.ssp import Component, Connection, SystemDescription
+
+    idle = idle_fmus(fmu_dir, tmp_path / "idle", ("VesselMotion", "AttitudeEstimator"))
+    sysd = SystemDescription("idle", (Component("vessel", "VesselMotion.fmu", {"sea.hs": 3.0}),
+                                      Component("att", "AttitudeEstimator.fmu")),
+                             (Connection.parse("vessel.imu.gyro.x", "att.gyro.x"),), 0.01, 1.0)
+    r = run_libcosim(sysd, idle, tmp_path, 1.0, ["vessel.imu.gyro.x", "att.roll", "att.valid"], 0.1)
+    assert r.size == 10 and r["time"][-1] == pytest.approx(1.0)
+    assert np.all(r["vessel.imu.gyro.x"] == 0.0) and np.all(r["att.roll"] == 0.0) and not r["att.valid"].any()
 
 
 def test_the_speed_table_splits_each_base_step_into_components_and_the_rest():

@@ -158,8 +158,10 @@ class {cls}(Fmi2Slave):
 
 def idle_fmus(fmu_dir: Path, dest: Path, models: tuple[str, ...]) -> Path:
     """FMUs with the variables of ``fmu_dir/<model>.fmu`` (names, types, causalities, start
-    values) whose ``doStep`` does nothing, written as ``dest/<model>.fmu``: the ``system``
-    scenario run on them measures what the master, FMPy and pythonfmu cost by themselves."""
+    values) whose ``doStep`` does nothing, written as ``dest/<model>.fmu`` with the real FMU's
+    ``<model>_OspModelDescription.xml`` beside it where there is one (libcosim reads it): the
+    ``system`` scenario run on them measures what the master, FMPy or libcosim, and pythonfmu
+    cost by themselves."""
     import shutil
     import tempfile
 
@@ -176,22 +178,30 @@ def idle_fmus(fmu_dir: Path, dest: Path, models: tuple[str, ...]) -> Path:
             script.write_text(_IDLE_SCRIPT.format(variables=variables, cls=cls, model=model))
             built = Path(FmuBuilder.build_FMU(script, dest=tmp))
             shutil.move(built, dest / f"{model}.fmu")
+            osp = fmu_dir / f"{model}_OspModelDescription.xml"
+            if osp.exists():
+                shutil.copy(osp, dest / osp.name)
     return dest
 
 
-def master_floor(fmu_dir: Path, work: Path, duration: float = 600.0) -> dict:
-    """The ``system`` scenario under the FMPy runner with :func:`idle_fmus`: the wall time of a
-    base step when the components compute nothing (the master's exchange and recording, FMPy's
-    and pythonfmu's calls), the real-time factor no Python estimator set can pass."""
+def master_floor(fmu_dir: Path, work: Path, duration: float = 600.0, engine: str = "fmpy") -> dict:
+    """The ``system`` scenario under ``engine`` (the FMPy runner, or libcosim as
+    :func:`~marinefmu.cosim.libcosim.run_libcosim` runs it, sampling every second) with
+    :func:`idle_fmus`: the wall time of a base step when the components compute nothing (the
+    master's exchange and recording, the engine's and pythonfmu's calls), the real-time factor
+    no Python estimator set can pass on that engine. The idle FMUs are built once in ``work``."""
     system = _system(None, None).system
     models = tuple(sorted({Path(c.source).stem for c in system.components}))
-    idle = idle_fmus(fmu_dir, work / "idle_fmus", models)
-    r = run_isolated("fmpy", idle, duration, work / "idle_run", scored=False)
+    idle = work / "idle_fmus"
+    if not all((idle / f"{m}.fmu").exists() for m in models):
+        idle_fmus(fmu_dir, idle, models)
+    run = work / f"idle_run_{engine}"
+    r = run_isolated(engine, idle, duration, run, scored=False)
     r.pop("scores", None)
-    (work / "idle_run" / "results.npy").unlink(missing_ok=True)
+    (run / "results.npy").unlink(missing_ok=True)
     r["base_step_us"] = 1e6 * r["wall_s"] / round(duration / system.step)
-    print(f"system speed, FMUs that do nothing (the master and FMI alone): {duration:g} s in {r['wall_s']:.2f} s, "
-          f"real-time factor {r['rtf']:.0f}, {r['base_step_us']:.0f} µs per base step", flush=True)
+    print(f"system speed, FMUs that do nothing (the master and FMI alone), {engine}: {duration:g} s in "
+          f"{r['wall_s']:.2f} s, real-time factor {r['rtf']:.0f}, {r['base_step_us']:.0f} µs per base step", flush=True)
     return r
 
 
@@ -256,9 +266,12 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
               f"peak memory {r['peak_rss_mb']:.0f} MB" + ("" if not r.get("step_us") else "; per base step in doStep: "
               + ", ".join(f"{k} {v:.0f} µs" for k, v in r["step_us"].items())), flush=True)
     result["speed"]["idle_fmus"] = master_floor(fmu_dir, work, duration)
+    result["speed"]["idle_fmus_libcosim"] = master_floor(fmu_dir, work, duration, "libcosim")
     speed = result["speed"]
     result["fmi_over_in_process"] = speed["python"]["rtf"] / speed["fmpy"]["rtf"]
-    result["floor_over"] = {e: speed["idle_fmus"]["rtf"] / speed[e]["rtf"] for e in ENGINES}
+    # each engine against its own floor (libcosim's: the idle FMUs under libcosim)
+    result["floor_over"] = {e: speed["idle_fmus_libcosim" if e == "libcosim" else "idle_fmus"]["rtf"] / speed[e]["rtf"]
+                            for e in ENGINES}
     result["table"] = speed_table(speed)
     goals = SPEED_GOALS
     print(f"FMI / in-process time ratio (FMPy runner / same code without FMI): {result['fmi_over_in_process']:.2f} "
@@ -272,9 +285,14 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
               f"{row['fmi_over_in_process']:6.2f}", flush=True)
     budget = component_budget_us(goals["rtf_fmpy"], speed["idle_fmus"]["rtf"], _system(None, None).step)
     spent = sum(speed["fmpy"]["step_us"].values())
-    result["component_budget_us"] = {"budget": budget, "spent": spent}
+    budget_libcosim = component_budget_us(goals["rtf_libcosim"], speed["idle_fmus_libcosim"]["rtf"],
+                                          _system(None, None).step)
+    result["component_budget_us"] = {"budget": budget, "spent": spent, "budget_libcosim": budget_libcosim}
     print(f"for a real-time factor of {goals['rtf_fmpy']:g} under the FMPy runner the components may spend "
           f"{budget:.0f} µs per base step together beside the floor; they spend {spent:.0f} µs", flush=True)
+    print(f"for a real-time factor of {goals['rtf_libcosim']:g} under libcosim (sampled as run_libcosim does) "
+          f"the components may spend {budget_libcosim:.0f} µs per base step beside its floor "
+          f"(below zero: out of reach whatever they do)", flush=True)
     result["first_second"] = first_second(fmu_dir, work)
     print(f"first second under the FMPy runner: {result['first_second']['wall_s']:.2f} s from loading the FMUs, "
           f"{result['first_second']['process_s']:.2f} s for the whole process", flush=True)
@@ -297,8 +315,11 @@ def markdown(data: dict) -> str:
     lines = ["| engine | wall time | real-time factor | floor's factor / this | peak memory |",
              "|---|---:|---:|---:|---:|"]
     names = {"fmpy": "FMPy runner (FMI)", "python": "the same slave code in-process, without FMI",
-             "libcosim": "OSP libcosim (sampled every second)", "idle_fmus": "FMPy runner, FMUs whose `doStep` does nothing"}
+             "libcosim": "OSP libcosim (sampled every second)", "idle_fmus": "FMPy runner, FMUs whose `doStep` does nothing",
+             "idle_fmus_libcosim": "OSP libcosim, FMUs whose `doStep` does nothing"}
     for e, label in names.items():
+        if e not in speed:
+            continue
         r = speed[e]
         ratio = data["floor_over"].get(e)
         lines.append(f"| {label} | {r['wall_s']:.1f} s | {r['rtf']:.1f} | {'—' if ratio is None else f'{ratio:.1f}'} | "
