@@ -193,7 +193,7 @@ def master_floor(fmu_dir: Path, work: Path, duration: float = 600.0, engine: str
     system = _system(None, None).system
     models = tuple(sorted({Path(c.source).stem for c in system.components}))
     idle = work / "idle_fmus"
-    if not all((idle / f"{m}.fmu").exists() for m in models):
+    if not all((idle / f"{m}{end}").exists() for m in models for end in (".fmu", "_OspModelDescription.xml")):
         idle_fmus(fmu_dir, idle, models)
     run = work / f"idle_run_{engine}"
     r = run_isolated(engine, idle, duration, run, scored=False)
@@ -283,10 +283,10 @@ def whole_system(fmu_dir: Path, work: Path, duration: float = 600.0, long_durati
     for row in result["table"]:
         print(f"  {row['component']:18s} {row['in_process_us']:7.0f} {row['fmi_us']:7.0f} "
               f"{row['fmi_over_in_process']:6.2f}", flush=True)
-    budget = component_budget_us(goals["rtf_fmpy"], speed["idle_fmus"]["rtf"], _system(None, None).step)
+    step = _system(None, None).step
+    budget = component_budget_us(goals["rtf_fmpy"], speed["idle_fmus"]["rtf"], step)
     spent = sum(speed["fmpy"]["step_us"].values())
-    budget_libcosim = component_budget_us(goals["rtf_libcosim"], speed["idle_fmus_libcosim"]["rtf"],
-                                          _system(None, None).step)
+    budget_libcosim = component_budget_us(goals["rtf_libcosim"], speed["idle_fmus_libcosim"]["rtf"], step)
     result["component_budget_us"] = {"budget": budget, "spent": spent, "budget_libcosim": budget_libcosim}
     print(f"for a real-time factor of {goals['rtf_fmpy']:g} under the FMPy runner the components may spend "
           f"{budget:.0f} µs per base step together beside the floor; they spend {spent:.0f} µs", flush=True)

@@ -55,23 +55,23 @@ def one_worker(create: Callable[[], T]) -> T:
     every step, and on a busy machine each hand-over waits for the scheduler. Made for one CPU,
     the pool steps the simulators one after the other without it, as the FMPy runner does; the
     results are the same (the algorithm stays Jacobi: each simulator reads the outputs held at
-    t). What it saves is measured in ``docs/decisions/libcosim-one-worker.md``.
+    t). What it saves is measured in ``docs/decisions/system-libcosim-one-worker.md``.
 
     How: the calling thread is held to one of its CPUs while ``create`` runs, so that the pool is
     made for one; then the calling thread and every thread ``create`` started get the calling
     thread's former CPUs back, so nothing stays pinned. Where the operating system has no
     ``sched_setaffinity`` (Windows, macOS), or refuses it, ``create()`` is called as it is.
 
-    Returns
-    -------
-    object
-        What ``create`` returned.
-
     Parameters
     ----------
     create : callable
         Makes and returns the execution, e.g.
         ``lambda: CosimExecution.from_osp_config_file(path)``.
+
+    Returns
+    -------
+    object
+        What ``create`` returned.
     """
     if not hasattr(os, "sched_setaffinity"):
         return create()
