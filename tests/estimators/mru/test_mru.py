@@ -193,3 +193,24 @@ def test_the_level_rotation_the_low_pass_and_the_turn_map_are_the_general_ones_w
         for _ in range(2):
             expected = lfilter([alpha], [1.0, alpha - 1.0], expected, axis=0, zi=[(1.0 - alpha) * start])[0]
         np.testing.assert_allclose(out, expected if from_zero else np.vstack([x[:1], expected]), rtol=1e-12, atol=1e-15)
+
+
+def test_the_scalar_low_pass_and_the_location_map_repeat_the_general_ones():
+    """``SlowLowPass.push_one`` is ``push`` of a one-entry list bit for bit (its start, a step
+    change and a state save included), and ``location_map`` turns a row of [R − I, the IMU's
+    motion] into the IMU's motion and the IMU's motion plus (R − I) r at every arm."""
+    from marinefmu.estimators.mru.level_frame import SlowLowPass, location_map
+    from marinefmu.frames import rot_nb
+
+    x = np.random.default_rng(5).normal(size=300)
+    for from_zero in (True, False):
+        general, scalar = SlowLowPass(30.0, from_zero=from_zero), SlowLowPass(30.0, from_zero=from_zero)
+        for k, v in enumerate(x):
+            dt = 0.01 if k < 150 else 0.02
+            assert scalar.push_one(float(v), dt) == general.push([float(v)], dt)[0]
+            if k == 200:
+                scalar.set_state(json.loads(json.dumps(scalar.get_state())))
+    arms = np.array([[25.0, -3.0, -8.0], [-40.0, 12.0, 5.0]])
+    rot, imu = rot_nb(0.05, -0.02, 0.3), np.array([0.4, -0.7, 1.2])
+    at = (np.concatenate([(rot - np.eye(3)).ravel(), imu]) @ location_map(arms)).reshape(3, 3)
+    np.testing.assert_allclose(at, np.vstack([imu, imu + arms @ rot.T - arms]), rtol=0, atol=1e-13)

@@ -284,7 +284,7 @@ class WienerAxis:
         self.k = 0
         self.next_detect = 0
         self.spectrum_buf = np.zeros(0)      # ring of window_max samples of a_v
-        self.sum_buf = np.zeros(0)           # running sum of a_v, twice over (contiguous reads)
+        self.sum_buf = np.zeros((0, 0))      # running sum of a_v by block phase, twice over (:meth:`nodes`)
         self.taps: np.ndarray | None = None  # (4, L) weights of block sums, newest block first
         self.tap_sums = np.zeros(4)          # the taps' sums over the samples
         self.total = 0.0                     # the running sum at the newest sample
@@ -305,9 +305,10 @@ class WienerAxis:
         self.block = max(1, int(round(BLOCK / dt)))
         self.blocks = max(2, int(round(MEMORY / (self.block * dt))))
         self.n_fir = self.block * self.blocks
+        self.slots = self.blocks + 1        # a phase's samples the ring keeps: the L + 1 nodes
         self.lag_steps = int(round(p.smoother_lag / dt))
         self.spectrum_buf = np.zeros(max(int(round(p.window / dt)), int(round(p.window_max / dt))))
-        self.sum_buf = np.zeros(2 * (self.n_fir + 1))
+        self.sum_buf = np.zeros((self.block, 2 * self.slots))
         self.next_detect = int(round((p.window if first_design is None else first_design) / dt))
         self.check_every = max(1, int(round(STEP_CHECK / dt)))
 
@@ -380,10 +381,10 @@ class WienerAxis:
         start, size = first + found.index, found.size
         n = len(self.spectrum_buf)
         self.spectrum_buf[np.arange(max(start, self.k - n), self.k) % n] -= size
-        n_sum = self.n_fir + 1
-        stored = np.arange(max(start, self.k - n_sum), self.k)
-        for offset in (0, n_sum):
-            self.sum_buf[stored % n_sum + offset] -= size * (stored - start + 1)
+        stored = np.arange(max(start, self.k - self.n_fir - 1), self.k)     # those a node can still read
+        phase, slot = stored % self.block, stored // self.block % self.slots
+        for offset in (0, self.slots):
+            self.sum_buf[phase, slot + offset] -= size * (stored - start + 1)
         self.total -= size * (self.k - start)
         self.level += size
 
@@ -416,10 +417,14 @@ class WienerAxis:
         due."""
         a_v = self.accept(a)
         self.spectrum_buf[self.k % len(self.spectrum_buf)] = a_v
-        n_sum = self.n_fir + 1
-        i = self.k % n_sum
-        self.sum_buf[i] = self.sum_buf[i + n_sum] = self.total
+        phase, slot = self.ring_position()
+        self.sum_buf[phase, slot] = self.sum_buf[phase, slot + self.slots] = self.total
         self.advance()
+
+    def ring_position(self) -> tuple[int, int]:
+        """Where the sample about to be recorded (the k-th) goes in :attr:`sum_buf`: its phase
+        in the block (row) and its block's slot (column, and the slot plus ``slots``)."""
+        return self.k % self.block, self.k // self.block % self.slots
 
     def accept(self, a: float | None) -> float:
         """The sample ``a`` [m/s²] as the buffers take it, a_v = a − level (the window's mean
@@ -428,26 +433,33 @@ class WienerAxis:
         self.total += a_v
         return a_v
 
-    def advance(self) -> None:
+    def advance(self) -> bool:
         """After a sample's ring writes: the sample count, and the bias-step search and the
-        design when they are due."""
+        design when they are due; whether a design ran (the taps and mean may have changed)."""
         self.k += 1
         if self.find_steps and self.k % self.check_every == 0:
             self._check_bias_step()
         if self.k >= self.next_detect:
             self._design()
+            return True
+        return False
 
     def nodes(self, buf: np.ndarray, blocks: int) -> np.ndarray:
         """The running sums at the newest sample and every block before it, ``blocks`` + 1 of
-        them, newest first, from ``buf`` (this axis's ``sum_buf``, or a stack of such buffers
-        along the last axis); a block's sum is the difference of two neighbours."""
-        n_sum = self.n_fir + 1
-        i = (self.k - 1) % n_sum + n_sum
-        return buf[..., i:i - blocks * self.block - 1:-self.block]
+        them, oldest first, from ``buf`` (this axis's ``sum_buf``, or a stack of such buffers
+        along a first axis); a block's sum is the difference of two neighbours.
+
+        The ring is laid out by block phase: row p holds the running sum at the samples k with
+        k mod ``block`` = p, one column per block, each written twice (``slots`` apart), so
+        that the nodes of any sample are one contiguous slice of one row: L + 1 neighbouring
+        numbers to read rather than L + 1 cache lines ``block`` samples apart."""
+        newest = self.k - 1
+        slot = newest // self.block % self.slots + self.slots
+        return buf[..., newest % self.block, slot - blocks:slot + 1]
 
     def output(self) -> np.ndarray:
         """Step 3's outputs of the current filter after :meth:`record` (as :meth:`push`)."""
-        nodes = self.nodes(self.sum_buf, self.taps.shape[1])
+        nodes = self.nodes(self.sum_buf, self.taps.shape[1])[::-1]          # newest first, as the taps
         return self.taps @ (nodes[:-1] - nodes[1:]) - self.mean * self.tap_sums
 
     def get_state(self) -> dict:
@@ -467,7 +479,8 @@ class WienerAxis:
         self.start(float(s["dt"]))
         self.k, self.next_detect = int(s["k"]), int(s["next_detect"])
         self.spectrum_buf = np.array(s["spectrum_buf"], dtype=float)
-        self.sum_buf, self.total = np.array(s["sum_buf"], dtype=float), float(s["total"])
+        self.sum_buf = np.array(s["sum_buf"], dtype=float).reshape(self.block, 2 * self.slots)
+        self.total = float(s["total"])
         if s["taps"] is not None:
             self.taps = np.array(s["taps"], dtype=float)
             self.tap_sums = self.taps.sum(axis=1) * self.block
@@ -481,11 +494,13 @@ class WienerGroup:
     """Several :class:`WienerAxis` filters stepped together, their outputs by one product.
 
     Each axis keeps its own buffers, spectrum, design and bias-step search; the group moves their
-    running sums into the rows of one array (each axis's ``sum_buf`` a view of its row, so the
-    axes' own in-place updates land there), writes a step's sums with one store per copy, and
-    holds their taps zero-padded to the longest memory, so that step 3 of all of them is one batched (A × 4 × L)·(A × L) product
-    instead of one product and a dozen small numpy calls per axis. The outputs equal each
-    axis's :meth:`WienerAxis.push` to rounding (the sums are formed in another order; the
+    running sums into one array, an axis's ring (:meth:`WienerAxis.nodes`) a slab of it (each
+    axis's ``sum_buf`` a view of its slab, so the axes' own in-place updates land there), writes
+    a step's sums with one store per copy, and holds their taps zero-padded to the longest
+    memory and turned to act on the nodes oldest first, so that step 3 of all of them is one
+    batched (A × 4 × L)·(A × L) product on contiguous rows, instead of one product and a dozen
+    small numpy calls per axis. It restacks the taps only after a design. The outputs equal
+    each axis's :meth:`WienerAxis.push` to rounding (the sums are formed in another order; the
     padding multiplies finite sums by zero).
 
     Parameters
@@ -500,7 +515,7 @@ class WienerGroup:
     def __init__(self, axes: list[WienerAxis]) -> None:
         self.axes = list(axes)
         self.sums = np.zeros((len(self.axes), 0))
-        self._designs: list[np.ndarray | None] = []       # the taps the stack below was built from
+        self._stale = True                                 # the stack below is not the axes' taps
         self._taps = np.zeros((len(self.axes), 4, 0))
         self._node_taps = np.zeros((len(self.axes), 4, 1))
         self._offsets = np.zeros((len(self.axes), 4))     # mean × the taps' sums, per axis
@@ -511,36 +526,35 @@ class WienerGroup:
         if any(a.dt != first.dt or a.block != first.block or a.blocks != first.blocks or a.k != first.k
                for a in self.axes):
             raise ValueError("WienerGroup: the axes must share dt, block, blocks and the sample count")
-        self.sums = np.zeros((len(self.axes), len(first.sum_buf)))
+        self.sums = np.zeros((len(self.axes), *first.sum_buf.shape))
         for row, axis in zip(self.sums, self.axes):
             if axis.k:             # restored or running: carry its sums (fresh ones are zeros, left untouched)
                 row[:] = axis.sum_buf
             axis.sum_buf = row
-        self._designs = []
+        self._stale = True
 
     def push(self, values: list[float | None]) -> np.ndarray | None:
         """One sample per axis (as :meth:`WienerAxis.push`): the (A, 4) outputs, a row per axis,
         or None while any axis has no design yet."""
         axes = self.axes
         first = axes[0]
-        a_v = [axis.accept(a) for axis, a in zip(axes, values)]     # WienerAxis.record for all axes
-        n_sum = first.n_fir + 1
         k = first.k
-        i = k % n_sum
-        for axis, v in zip(axes, a_v):
-            axis.spectrum_buf[k % len(axis.spectrum_buf)] = v
-        totals = [axis.total for axis in axes]
-        self.sums[:, i] = totals
-        self.sums[:, i + n_sum] = totals
+        phase, slot = first.ring_position()
+        totals = []                                     # WienerAxis.record for all axes
+        for axis, a in zip(axes, values):
+            axis.spectrum_buf[k % len(axis.spectrum_buf)] = axis.accept(a)
+            totals.append(axis.total)
+        sums = self.sums
+        sums[:, phase, slot] = totals
+        sums[:, phase, slot + first.slots] = totals
         for axis in axes:
-            axis.advance()
-        if len(self._designs) != len(axes) or any(a.taps is not t for a, t in zip(axes, self._designs)):
+            if axis.advance():                          # only a design changes the taps and the mean
+                self._stale = True
+        if self._stale:
             if any(a.taps is None for a in axes):
                 return None
             self._stack_taps()
-        # the strided nodes copied together first: matmul on the strided view is slower than
-        # the copy and a contiguous product
-        nodes = np.ascontiguousarray(axes[0].nodes(self.sums, self._taps.shape[2]))
+        nodes = axes[0].nodes(self.sums, self._taps.shape[2])      # (A, L + 1), each row contiguous
         return np.matmul(self._node_taps, nodes[:, :, None])[:, :, 0] - self._offsets
 
     def _stack_taps(self) -> None:
@@ -558,9 +572,10 @@ class WienerGroup:
             row[:, :axis.taps.shape[1]] = axis.taps
         padded = np.zeros((len(self.axes), 4, longest + 2))
         padded[:, :, 1:-1] = self._taps
-        self._node_taps = np.diff(padded, axis=2)       # (A, 4, L + 1): d_j = h_j − h_{j−1}
+        # (A, 4, L + 1): d_j = h_j − h_{j−1}, oldest node first as :meth:`WienerAxis.nodes` gives them
+        self._node_taps = np.ascontiguousarray(np.diff(padded, axis=2)[:, :, ::-1])
         self._offsets = np.array([a.mean * a.tap_sums for a in self.axes])
-        self._designs = [a.taps for a in self.axes]
+        self._stale = False
 
 
 class WienerHeave(WienerAxis):

@@ -77,6 +77,17 @@ class SlowLowPass:
         self.stages = [first, second]
         return second
 
+    def push_one(self, x: float, dt: float) -> float:
+        """:meth:`push` of one number, without its lists (the level frame's yaw, every step)."""
+        if self.stages is None or dt != self.dt:
+            return self.push([x], dt)[0]
+        alpha = self.alpha
+        (first,), (second,) = self.stages
+        first += alpha * (x - first)
+        second += alpha * (first - second)
+        self.stages = [[first], [second]]
+        return second
+
     def get_state(self) -> list | None:
         """JSON-serialisable state."""
         return None if self.stages is None else [list(v) for v in self.stages]
@@ -116,6 +127,18 @@ def turn_map(arms: np.ndarray) -> np.ndarray:
     for i in range(3):
         m[:, i, i, :] = arms
     return m.reshape(3 * len(arms), 9)
+
+
+def location_map(arms: np.ndarray) -> np.ndarray:
+    """(12, 3(P + 1)) map from one row of [the nine entries of R − I, the IMU's surge, sway and
+    heave] to the surge, sway and heave of the IMU and of each of the P points at ``arms``
+    (P, 3) [m], in that order: the IMU's motion plus (R − I) r (:func:`turn_map`), so that a
+    quantity (position, rate, acceleration, delayed position) at every location is one product."""
+    arms = np.asarray(arms, dtype=float).reshape(-1, 3)
+    m = np.zeros((12, 3 * (len(arms) + 1)))
+    m[:9, 3:] = turn_map(arms).T
+    m[9:, :] = np.tile(np.eye(3), len(arms) + 1)
+    return m
 
 
 def unwrap(previous: float, yaw: float) -> float:

@@ -81,13 +81,17 @@ class MotionReferenceUnitParams:
         check_range("heading_tau", self.heading_tau, lo=1.0, hi=3600.0, unit="s")
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class MruResult:
     """Output of one :meth:`~marinefmu.estimators.mru.unit.MotionReferenceUnit.step`.
 
     Rows of the (P + 1, ·) arrays: the IMU, then the monitoring points in order. Columns of the
     (·, 3) arrays: surge, sway, heave, i.e. x forward, y starboard, z down of the vessel's level
     frame (heave positive down), about the point's mean position.
+
+    Not frozen, unlike the parameters: a frozen dataclass sets each of its fourteen fields
+    through ``object.__setattr__``, about 2 µs a step, more than the rest of the result's
+    assembly. Before the motion is valid the arrays are shared read-only zeros.
 
     Attributes
     ----------

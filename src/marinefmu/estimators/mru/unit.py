@@ -37,7 +37,9 @@ What runs when: every step, the attitude, the level frame's rows and a_h on Pyth
 as one batched product (:class:`~marinefmu.estimators.heave.wiener.WienerGroup`), and the
 points' arms: the nine entries of R − I and their slow mean on floats, one (2 × W)·(W × 9)
 product on a contiguous slice of their ring (stored twice for it) for the rates and
-accelerations, and one (4 × 9)·(9 × 3P) product to every point (:func:`~.level_frame.turn_map`);
+accelerations, and one (4 × 12)·(12 × 3(P + 1)) product from them and the IMU's motion to every
+location's (:func:`~.level_frame.location_map`); before every filter has a design, shared
+read-only zeros;
 every second, the heave filter's bias-step search;
 first after ``motion.window`` s and then every :data:`DESIGN_ROUNDS` × ``motion.peak_interval``
 s, each filter's Wiener design, the four a quarter of an interval apart (on average one
@@ -64,7 +66,7 @@ from ..attitude.estimator import AttitudeEstimator, AttitudeResult
 from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW
-from .level_frame import SlowLowPass, derivative_weights, level_rows, turn_map, unwrap
+from .level_frame import SlowLowPass, derivative_weights, level_rows, location_map, unwrap
 from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
@@ -86,6 +88,14 @@ def yaw_filter_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
     a = params.attitude
     return replace(params.motion, acc_noise=a.gyro_noise,
                    offset_noise=min(10.0, a.gyro_bias_sigma * math.sqrt(2.0 / a.gyro_bias_tau)))
+
+
+def zero_outputs(rows: int) -> tuple[np.ndarray, np.ndarray]:
+    """Read-only zero (rows, 3) motion and (rows,) heave acceleration: the outputs before every
+    filter has a design, shared by every such step (no arrays to build while nothing is known)."""
+    zeros, zero_acc = np.zeros((rows, 3)), np.zeros(rows)
+    zeros.flags.writeable = zero_acc.flags.writeable = False
+    return zeros, zero_acc
 
 
 def euler_yaw_rate(gyro: Any, att: AttitudeResult) -> float:
@@ -117,7 +127,7 @@ class MotionReferenceUnit:
         self.params = params or MotionReferenceUnitParams()
         self.log: Any = SilentLog() if quiet else log
         self.arms = np.array(self.params.points, dtype=float).reshape(-1, 3)      # (P, 3) body [m]
-        self.turn_map_t = np.ascontiguousarray(turn_map(self.arms).T)           # (9, 3P): (R − I) → (R − I) r
+        self.point_map = location_map(self.arms)        # (12, 3(P + 1)): the points' terms and the IMU's motion
         self.reset()
 
     def reset(self) -> None:
@@ -137,7 +147,9 @@ class MotionReferenceUnit:
         self.rot_rows = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)   # R_hb of the last good sample, row by row
         self.heave_acc = 0.0                          # the last good vertical acceleration [m/s²]
         self.turn_ring = np.zeros((0, 9))
-        self.terms = np.zeros((4, 9))
+        self.terms = np.zeros((4, 12))
+        self.delay_s = 0.0
+        self.no_motion = zero_outputs(len(self.arms) + 1)
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -155,7 +167,11 @@ class MotionReferenceUnit:
         # each sample twice, so that the last W are one slice; none without points (its length
         # grows as 1/dt: a 1 µs step would take gigabytes)
         self.turn_ring = np.zeros((2 * ring if len(self.arms) else 0, 9))
-        self.terms = np.zeros((4, 9))    # the turn's position, rate, acceleration and delayed position
+        # rows: position, rate, delayed position, acceleration; columns: the turn's nine entries
+        # (its rate and acceleration from the fit), then the IMU's surge, sway and heave (of the
+        # acceleration row only the heave: the other two stay zero)
+        self.terms = np.zeros((4, 12))
+        self.delay_s = self.axes[0].delay
         self.delayed_from = m.window + m.peak_interval * 3.0 / 4.0 + self.axes[0].delay
 
     @property
@@ -194,17 +210,19 @@ class MotionReferenceUnit:
             self.start(dt)
         att = self.attitude.step(gyro, acc, dt)
         good = att.valid and att.warning is None
-        a_h = None
+        points = len(self.arms)
+        values: list[float | None]
         if good:
             self.yaw = att.yaw if self.yaw is None else unwrap(self.yaw, att.yaw)
-            r = self.rot_rows = level_rows(self.yaw_ref.push([self.yaw], dt)[0], att.q)
+            r = self.rot_rows = level_rows(self.yaw_ref.push_one(self.yaw, dt), att.q)
             f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
-            a_h = (r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2,
-                   r[6] * f0 + r[7] * f1 + r[8] * f2 + G)
-        points = len(self.arms)
-        values: list[float | None] = [None, None, None] if a_h is None else list(a_h)
-        if points:                                     # the yaw filter serves the lever arms only
-            values.append(euler_yaw_rate(gyro, att) if good else None)
+            heave_acc = r[6] * f0 + r[7] * f1 + r[8] * f2 + G
+            values = [r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2, heave_acc]
+            if points:                                 # the yaw filter serves the lever arms only
+                values.append(euler_yaw_rate(gyro, att))
+        else:
+            heave_acc = None
+            values = [None] * (4 if points else 3)
         out = self.group.push(values)                  # (axes, 4): position, rate, delayed position, rate
         ring = self.turn_ring
         n = len(ring) // 2
@@ -217,48 +235,45 @@ class MotionReferenceUnit:
                     yaw_wave = None if self.yaw_axis.taps is None else float(self.yaw_axis.output()[1])
                 rot = self.rot_rows if yaw_wave is None else rot_nb_rows(att.roll, att.pitch, yaw_wave)
                 turn = [v - e for v, e in zip(rot, IDENTITY_ROWS)]              # R_hb − I
-                ring[i] = ring[i + n] = [t - m for t, m in zip(turn, self.turn_mean.push(turn, dt))]
+                ring[i::n] = [t - m for t, m in zip(turn, self.turn_mean.push(turn, dt))]
             elif self.k == 0:
-                ring[i] = ring[i + n] = 0.0
+                ring[i::n] = 0.0
             else:
-                ring[i] = ring[i + n] = ring[(self.k - 1) % n]
+                ring[i::n] = ring[(self.k - 1) % n]
         self.k += 1
         heave_axis = self.axes[2]
-        if a_h is not None:
-            self.heave_acc = a_h[2] - heave_axis.level - heave_axis.mean
-        yaw_out, heading_used, heading_warning = self._heading(att.yaw, heading, heading_valid, dt)
+        if heave_acc is not None:
+            self.heave_acc = heave_acc - heave_axis.level - heave_axis.mean
+        if heading is None and self.heading_offset is None:
+            yaw_out, heading_used, heading_warning = att.yaw, False, None
+        else:
+            yaw_out, heading_used, heading_warning = self._heading(att.yaw, heading, heading_valid, dt)
         warning = restart or att.warning or heading_warning
         angles_valid = att.valid and heading_warning is None
-        rows = points + 1
         if out is None:
-            zeros = np.zeros((rows, 3))
-            return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros.copy(), np.zeros(rows), zeros.copy(),
-                             self.delay, heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
-        o = out[:3, :3].T                          # (3, 3 axes): position, rate, delayed position
+            zeros, zero_acc = self.no_motion
+            return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros, zero_acc, zeros, self.delay_s,
+                             heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
+        delayed_valid = good and self.k * dt >= self.delayed_from
         if not points:                             # the IMU's row only: views of this step's own outputs
-            motion = o[:, None, :]
-            return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], np.array([self.heave_acc]),
-                             motion[2], self.delay, heave_axis.peak_period, angles_valid, good,
-                             good and self.k * dt >= self.delayed_from, heading_used, warning)
-        motion = np.empty((3, rows, 3))            # position, velocity, delayed position: IMU, then points
-        motion[:, 0] = o
-        heave_acc = np.empty(rows)
-        heave_acc[0] = self.heave_acc
+            return MruResult(att.roll, att.pitch, yaw_out, out[None, :3, 0], out[None, :3, 1],
+                             np.array([self.heave_acc]), out[None, :3, 2], self.delay_s, heave_axis.peak_period,
+                             angles_valid, good, delayed_valid, heading_used, warning)
         w = self.weights.shape[1]
         j = (self.k - 1) % n                   # the newest sample's row
         terms = self.terms
-        terms[0] = ring[j]
-        if self.k >= w:
-            np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1:3])   # oldest first
+        terms[0, :9] = ring[j]
+        if self.k >= w:                        # the rate and acceleration rows; oldest sample first
+            np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1::2, :9])
         else:
-            terms[1:3] = 0.0
-        terms[3] = ring[(self.k - 1 - self.lag_steps) % n]
-        at = (terms @ self.turn_map_t).reshape(4, points, 3)      # d, ḋ, d̈ and the delayed d per point
-        np.add(o[:, None, :], at[[0, 1, 3]], out=motion[:, 1:])
-        np.add(self.heave_acc, at[2, :, 2], out=heave_acc[1:])
-        return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], heave_acc, motion[2], self.delay,
-                         heave_axis.peak_period, angles_valid, good, good and self.k * dt >= self.delayed_from,
-                         heading_used, warning)
+            terms[1::2, :9] = 0.0
+        terms[2, :9] = ring[(self.k - 1 - self.lag_steps) % n]
+        terms[:3, 9:] = out[:3, :3].T
+        terms[3, 11] = self.heave_acc
+        at = terms @ self.point_map            # (4, 3(P + 1)): every location's d + the IMU's motion
+        motion = at[:3].reshape(3, points + 1, 3)
+        return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], at[3, 2::3], motion[2], self.delay_s,
+                         heave_axis.peak_period, angles_valid, good, delayed_valid, heading_used, warning)
 
     def _heading(self, yaw: float, heading: float | None, heading_valid: bool,
                  dt: float) -> tuple[float, bool, str | None]:
