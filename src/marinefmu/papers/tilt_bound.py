@@ -179,20 +179,31 @@ class BoundSetup:
         if self.memory > self.settle:
             raise ValueError(f"memory {self.memory:g} s is longer than the settling time {self.settle:g} s")
 
-    def rows(self, rec: dict[str, np.ndarray], start: float) -> tuple[np.ndarray, np.ndarray]:
-        """Rows and (rows, 2) targets (true roll, pitch [rad]) from ``start`` s on (module
-        docstring): per block the angle change to now (3), then :func:`block_rows` of
-        :func:`channels` (rate, specific force, constant)."""
-        edges = block_edges(self.memory, self.dt, self.resolution, self.longest)
-        n = len(rec["truth.roll"])
+    def edges(self) -> np.ndarray:
+        """:func:`block_edges` of this set-up [samples]."""
+        return block_edges(self.memory, self.dt, self.resolution, self.longest)
+
+    def ends(self, n: int, start: float) -> np.ndarray:
+        """Sample indices of the rows of a record of ``n`` samples: one every ``stride`` s from
+        ``start`` s on, none before the memory is full."""
         step = max(1, int(round(self.stride / self.dt)))
-        first = max(edges[-1], int(round(start / self.dt)) - 1)
-        ends = np.arange(first, n, step)
+        return np.arange(max(self.edges()[-1], int(round(start / self.dt)) - 1), n, step)
+
+    def features(self, rec: dict[str, np.ndarray], ends: np.ndarray) -> np.ndarray:
+        """Rows at the samples ``ends`` (module docstring): per block the angle change to now (3),
+        then :func:`block_rows` of :func:`channels` (rate, specific force, constant)."""
+        edges = self.edges()
         inputs = channels(rec, self.linearise)
         x = block_rows(inputs, edges, ends)
         turned = angle_changes(inputs[:, :3], self.dt)
         change = block_rows(turned, edges, ends)[:, :-1] - np.repeat(turned[ends], len(edges) - 1, axis=1)
-        return np.column_stack([change, x]), np.column_stack([rec["truth.roll"][ends], rec["truth.pitch"][ends]])
+        return np.column_stack([change, x])
+
+    def rows(self, rec: dict[str, np.ndarray], start: float) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`features` and (rows, 2) targets (true roll, pitch [rad]) from ``start`` s on
+        (:meth:`ends`)."""
+        ends = self.ends(len(rec["truth.roll"]), start)
+        return self.features(rec, ends), np.column_stack([rec["truth.roll"][ends], rec["truth.pitch"][ends]])
 
 
 def fit(pairs: list[tuple[np.ndarray, np.ndarray]], ridge: float = RIDGE) -> np.ndarray:
