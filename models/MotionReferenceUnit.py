@@ -49,7 +49,7 @@ else:
                 at = 3 + 10 * place
                 reals[at:at + 10] = (*r.position[row], *r.velocity[row], r.heave_acc[row], *r.delayed_position[row])
             self.io.set_outputs([*reals, r.delay, r.wave_period],
-                                [r.valid, r.motion_valid, r.delayed_valid, r.heading_used])
+                                [r.valid, r.motion_valid, r.delayed_valid, r.heading_used, r.joint])
 
         def _get_fmu_state(self):
             return self.io.get_state(self.model)

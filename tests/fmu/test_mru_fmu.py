@@ -16,7 +16,7 @@ LOCATION = ("surge", "sway", "heave", "surge_rate", "sway_rate", "heave_rate", "
             "delayed.sway", "delayed.heave")
 OUTS = ["roll", "pitch", "yaw", *LOCATION, *(f"mp2.{n}" for n in LOCATION), "mp1.heave", "delayed.delay",
         "wave_period"]
-FLAGS = ("valid", "motion.valid", "delayed.valid", "heading.used")
+FLAGS = ("valid", "motion.valid", "delayed.valid", "heading.used", "motion.joint")
 
 
 @pytest.mark.fmu
@@ -43,7 +43,7 @@ def test_mru_fmu_equals_in_process(fmu_dir, tmp_path):
                     *r.position[1], *r.velocity[1], r.heave_acc[1], *r.delayed_position[1],
                     0.0, r.delay, r.wave_period]
         assert reals == expected, k
-        assert flags == [r.valid, r.motion_valid, r.delayed_valid, r.heading_used], k
+        assert flags == [r.valid, r.motion_valid, r.delayed_valid, r.heading_used, r.joint], k
         if k == nan_at:
             assert not flags[0] and not flags[1] and all(np.isfinite(reals))
     assert flags[:3] == [True, True, True]

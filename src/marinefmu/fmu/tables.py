@@ -328,6 +328,9 @@ MRU_PARAMETERS: list[Variable] = [
     real("acc_noise", _MRU.motion.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 1]"),
     real("delayed_lag", _MRU.motion.smoother_lag, "s", "Delay of the delayed outputs, [0, 120]"),
     real("heading_tau", _MRU.heading_tau, "s", "Time constant of the heading aid, [1, 3600]"),
+    Variable("motion_model", "string", _MRU.motion_model, "", "Real-time motion at the IMU: joint (all six IMU "
+             "channels, taught by the axis filters' delayed outputs) or axis (one filter per axis, paper 003)"),
+    real("joint_memory", _MRU.joint_memory, "s", "Span of the joint filter's past, [10, 300]"),
     Variable("aid_sizing", "string", _MRU.attitude.aid_sizing, "", f"Attitude aiding size: one of {', '.join(AID_SIZINGS)} (as the AttitudeEstimator's)"),
     real("vel_sigma", _MRU.attitude.vel_sigma, "m/s", "Attitude zero-velocity pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 100]"),
     real("pos_sigma", _MRU.attitude.pos_sigma, "m", "Attitude zero-position pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 1000]"),
@@ -362,6 +365,8 @@ MRU_BOOLEANS: list[Variable] = [
     Variable("motion.valid", "boolean", False, "", "The real-time motion: false until every axis's first spectrum and on a rejected sample"),
     Variable("delayed.valid", "boolean", False, "", "The delayed outputs refer to a time the filters have run through"),
     Variable("heading.used", "boolean", False, "", "yaw is north-referenced"),
+    Variable("motion.joint", "boolean", False, "", "The real-time motion is the joint filter's (taught), "
+             "else the axis filters'"),
 ]
 
 
@@ -375,7 +380,8 @@ def mru_params(values: dict[str, Any]) -> MotionReferenceUnitParams:
                      omega_max=v["omega_max"], acc_noise=v["acc_noise"], smoother_lag=v["delayed_lag"])
     attitude = replace(_MRU.attitude, aid_sizing=v["aid_sizing"], vel_sigma=v["vel_sigma"], pos_sigma=v["pos_sigma"],
                        aid_rate=v["aid_rate"])
-    return MotionReferenceUnitParams(attitude=attitude, motion=motion, points=points, heading_tau=v["heading_tau"])
+    return MotionReferenceUnitParams(attitude=attitude, motion=motion, points=points, heading_tau=v["heading_tau"],
+                                     motion_model=v["motion_model"], joint_memory=v["joint_memory"])
 
 
 # --- AHC FMUs: AhcWinch and AhcController ---

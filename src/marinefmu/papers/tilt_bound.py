@@ -20,7 +20,7 @@ what an attitude estimator does:
 * the gyro's bias is a Gauss–Markov process: over a finite memory its integral is a random
   walk the fit weighs against the accelerometer's wave leak, as a Kalman filter's gain does.
 
-Blocks are short for the recent past and grow with age (:func:`block_edges`): a tenth of their
+Blocks are short for the recent past and grow with age (:func:`~marinefmu.estimators.mru.joint.block_edges`): a tenth of their
 age by default, at most ``longest`` seconds, so that three minutes at 20 Hz need ninety
 blocks per channel.
 
@@ -57,6 +57,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..estimators.attitude.estimator import AttitudeEstimatorParams, estimate_attitude
+from ..estimators.mru.joint import block_edges
 from ..sea.motion_model import VesselMotion, VesselMotionParams, simulate_record, stack
 from ..sea.sensors import IMU_GRADES
 
@@ -137,19 +138,8 @@ def angle_changes(rate: np.ndarray, dt: float) -> np.ndarray:
     return c
 
 
-def block_edges(memory: float, dt: float, resolution: float = 0.1, longest: float = 5.0) -> np.ndarray:
-    """Ages [samples] of the block boundaries, 0 = now: block j holds the samples k − e_{j+1} < i ≤
-    k − e_j of the row at sample k. Each block is ``resolution`` × its age long (at least one
-    sample, at most ``longest`` s), up to ``memory`` s."""
-    edges, n_max = [0], int(round(memory / dt))
-    longest_n = max(1, int(round(longest / dt)))
-    while edges[-1] < n_max:
-        edges.append(min(n_max, edges[-1] + min(longest_n, max(1, int(resolution * edges[-1])))))
-    return np.array(edges)
-
-
 def block_rows(x: np.ndarray, edges: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """Regression rows: for each sample index of ``ends``, the block means (:func:`block_edges`)
+    """Regression rows: for each sample index of ``ends``, the block means (:func:`~marinefmu.estimators.mru.joint.block_edges`)
     of every column of ``x`` ((N, c)), then a constant; (len(ends), c·(len(edges) − 1) + 1).
     With one channel and equal blocks this is :func:`~marinefmu.papers.paper003.fir_rows`'s
     layout, oldest block first."""
@@ -180,7 +170,7 @@ class BoundSetup:
             raise ValueError(f"memory {self.memory:g} s is longer than the settling time {self.settle:g} s")
 
     def edges(self) -> np.ndarray:
-        """:func:`block_edges` of this set-up [samples]."""
+        """:func:`~marinefmu.estimators.mru.joint.block_edges` of this set-up [samples]."""
         return block_edges(self.memory, self.dt, self.resolution, self.longest)
 
     def ends(self, n: int, start: float) -> np.ndarray:

@@ -66,6 +66,7 @@ from ..attitude.estimator import AttitudeEstimator, AttitudeResult
 from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW
+from .joint import JointMotion, linear_channels
 from .level_frame import SlowLowPass, derivative_weights, level_rows, location_map, unwrap
 from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
@@ -150,6 +151,7 @@ class MotionReferenceUnit:
         self.terms = np.zeros((4, 12))
         self.delay_s = 0.0
         self.no_motion = zero_outputs(len(self.arms) + 1)
+        self.joint: JointMotion | None = None
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -173,6 +175,8 @@ class MotionReferenceUnit:
         self.terms = np.zeros((4, 12))
         self.delay_s = self.axes[0].delay
         self.delayed_from = m.window + m.peak_interval * 3.0 / 4.0 + self.axes[0].delay
+        if self.params.motion_model == "joint":
+            self.joint = JointMotion(self.params.joint_memory, dt, self.lag_steps, m.window_max)
 
     @property
     def rot(self) -> np.ndarray:
@@ -218,11 +222,20 @@ class MotionReferenceUnit:
             f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
             heave_acc = r[6] * f0 + r[7] * f1 + r[8] * f2 + G
             values = [r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2, heave_acc]
-            if points:                                 # the yaw filter serves the lever arms only
+            if self.joint is not None:
+                b = att.gyro_bias
+                rates = (float(gyro[0]) - float(b[0]), float(gyro[1]) - float(b[1]), float(gyro[2]) - float(b[2]))
+                channels = linear_channels(rates, att.roll, att.pitch, values)
+                self.joint.push(channels)
+                if points:                             # the yaw filter serves the lever arms only
+                    values.append(channels[2])
+            elif points:
                 values.append(euler_yaw_rate(gyro, att))
         else:
             heave_acc = None
             values = [None] * (4 if points else 3)
+            if self.joint is not None:
+                self.joint.push(None)
         out = self.group.push(values)                  # (axes, 4): position, rate, delayed position, rate
         ring = self.turn_ring
         n = len(ring) // 2
@@ -255,10 +268,20 @@ class MotionReferenceUnit:
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros, zero_acc, zeros, self.delay_s,
                              heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
         delayed_valid = good and self.k * dt >= self.delayed_from
+        joint = self.joint
+        now = None                                 # the joint filter's (2, 3) position and rate, once taught
+        if joint is not None:
+            joint.teach(out[:3, 2:4] if delayed_valid else None)
+            if joint.ready:
+                now = joint.predict()
         if not points:                             # the IMU's row only: views of this step's own outputs
-            return MruResult(att.roll, att.pitch, yaw_out, out[None, :3, 0], out[None, :3, 1],
+            if now is None:
+                position, velocity = out[None, :3, 0], out[None, :3, 1]
+            else:
+                position, velocity = now[None, 0], now[None, 1]
+            return MruResult(att.roll, att.pitch, yaw_out, position, velocity,
                              np.array([self.heave_acc]), out[None, :3, 2], self.delay_s, heave_axis.peak_period,
-                             angles_valid, good, delayed_valid, heading_used, warning)
+                             angles_valid, good, delayed_valid, heading_used, warning, now is not None)
         w = self.weights.shape[1]
         j = (self.k - 1) % n                   # the newest sample's row
         terms = self.terms
@@ -269,11 +292,14 @@ class MotionReferenceUnit:
             terms[1::2, :9] = 0.0
         terms[2, :9] = ring[(self.k - 1 - self.lag_steps) % n]
         terms[:3, 9:] = out[:3, :3].T
+        if now is not None:
+            terms[:2, 9:] = now
         terms[3, 11] = self.heave_acc
         at = terms @ self.point_map            # (4, 3(P + 1)): every location's d + the IMU's motion
         motion = at[:3].reshape(3, points + 1, 3)
         return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], at[3, 2::3], motion[2], self.delay_s,
-                         heave_axis.peak_period, angles_valid, good, delayed_valid, heading_used, warning)
+                         heave_axis.peak_period, angles_valid, good, delayed_valid, heading_used, warning,
+                         now is not None)
 
     def _heading(self, yaw: float, heading: float | None, heading_valid: bool,
                  dt: float) -> tuple[float, bool, str | None]:
@@ -300,7 +326,8 @@ class MotionReferenceUnit:
                 "axes": [axis.get_state() for axis in self.axes], "yaw_axis": self.yaw_axis.get_state(),
                 "yaw_ref": self.yaw_ref.get_state(),
                 "turn_mean": self.turn_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
-                "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist()}
+                "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist(),
+                "joint": None if self.joint is None else self.joint.get_state()}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -319,3 +346,5 @@ class MotionReferenceUnit:
         self.rot_rows = tuple(float(v) for v in np.ravel(s["rot"]))
         self.heave_acc = float(s["heave_acc"])
         self.turn_ring = np.array(s["turn_ring"], dtype=float).reshape(-1, 9)
+        if self.joint is not None and s.get("joint") is not None:
+            self.joint.set_state(s["joint"])

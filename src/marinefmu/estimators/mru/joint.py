@@ -1,0 +1,277 @@
+"""The joint motion filter: the IMU's real-time surge, sway and heave, and their rates, from the
+past of all six IMU channels, a causal linear filter taught by the unit's own delayed outputs.
+
+**Why.** One filter per level-frame axis (paper 003's observer generalised,
+:class:`~marinefmu.estimators.heave.wiener.WienerAxis`) reads that axis's acceleration alone.
+In a sea where one wave train drives all six motions, the other channels tell it much more: the
+gyro's angles, precise at wave frequencies, predict the accelerations, and the vertical, which
+the attitude's tilt error reaches only at second order, predicts the horizontal. The least-variance
+causal linear estimate from all channels (:func:`marinefmu.papers.motion_bound.causal_motion_bound`)
+lies 2-3 × below one filter per axis fed the *true* attitude; the per-axis filters also take the
+AttitudeEstimator's in-band tilt error ε as motion (g·ε/ω² of displacement), which the joint
+filter, reading the same specific force as a linear function of the tilt, does not.
+
+**What it fits.** The rows are those of the bound (:meth:`JointMotion.features`): over the last
+``memory`` seconds, block means (:func:`block_edges`: blocks a tenth of their age long, at most
+:data:`LONGEST_BLOCK`) of nine channels, the Euler rates u = T(φ, θ)(ω − b̂) [rad/s], the level
+frame's specific force linearised, a_h + g [θ, −φ, 0] [m/s²] (to first order the specific force
+turned by the yaw alone, so that it is a linear function of the raw samples and the attitude's
+tilt error cancels from it), and the Euler angles' change from each block to now (the trapezoidal
+integral of u [rad]), then a constant. The targets are what the unit's three axis filters give
+``lag`` s late, their fixed-lag (Wiener smoother) position and rate, which err 3-10 × less than
+their real-time outputs: the rows at t − lag are regressed on the smoothed motion at t − lag, and
+the fit applied to the rows at t. Least squares with a ridge ρ of the mean diagonal
+(:data:`RIDGE`),
+
+.. math::
+    W = (N + ρ\\,\\overline{\\mathrm{diag}N}\\, I)^{-1} M,\\qquad
+    N ← λN + X^T X,\\quad M ← λM + X^T Y,\\quad λ = e^{-T/τ},
+
+over the rows of each refit interval T (:data:`REFIT`), forgotten with the time constant τ of the
+axis filters' longest spectrum window (``window_max``), solved by Cholesky (``scipy.linalg``). The
+smoother's own error is mostly not a linear function of the rows at t − lag (it depends on the
+samples after it), so the fit converges to the smoothed motion's causal part, not to its error.
+
+**Per step** the filter writes the channels' running sums to a ring (each row twice, so that any
+age is one index) and reads the running sums at the block edges: the prediction is linear in them,
+y = Σ_a S_{k−a} V_a + c, with V folded from W at each refit (:meth:`JointMotion._fold`), one
+gather and one product. Until the first fit (:data:`WARMUP_RATIO` taught rows per weight) it
+gives nothing and the unit keeps its axis filters' outputs.
+
+Hand-written least squares (numpy and ``scipy.linalg.cho_factor``): neither scipy, filterpy nor
+python-control fits a multichannel causal filter from data.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from scipy.linalg import LinAlgError, cho_factor, cho_solve
+
+from ...frames import G
+
+#: Longest block of the rows [s]: a wave of 5 s or more is a smooth curve over it.
+LONGEST_BLOCK = 2.0
+#: Block length relative to its age (:func:`block_edges`).
+RESOLUTION = 0.1
+#: Shortest block after the newest sample [s]: 20 Hz resolves every wave and the vessel's
+#: response to it, and fewer blocks cost less per step (:meth:`JointMotion.predict`).
+SHORTEST_BLOCK = 0.05
+#: Interval between taught rows [s].
+STRIDE = 0.5
+#: Interval between refits [s].
+REFIT = 120.0
+#: Taught rows per weight before the first fit: with fewer the fit follows the teacher's
+#: errors (2 × 640 rows, 640 s at the defaults and 100 Hz: the first fit's errors are then those
+#: of the later ones; after 300 s they were up to 1.9 × the axis filters' in heave).
+WARMUP_RATIO = 2.0
+#: Ridge, relative to the normal matrix's mean diagonal.
+RIDGE = 1e-7
+#: Number of channels: angle changes (3), Euler rates (3), specific force (3).
+CHANNELS = 9
+#: Number of targets: position (3) then rate (3), surge, sway, heave.
+TARGETS = 6
+
+
+def block_edges(memory: float, dt: float, resolution: float = RESOLUTION, longest: float = LONGEST_BLOCK,
+                shortest: float = 0.0) -> np.ndarray:
+    """Ages [samples] of the block boundaries, 0 = now: block j holds the samples k − e_{j+1} < i ≤
+    k − e_j of the row at sample k. The first block is the newest sample; each later one is
+    ``resolution`` × its age long, at least ``shortest`` s (and one sample) and at most
+    ``longest`` s, up to ``memory`` s."""
+    edges, n_max = [0, 1], int(round(memory / dt))
+    longest_n = max(1, int(round(longest / dt)))
+    shortest_n = max(1, int(round(shortest / dt)))
+    while edges[-1] < n_max:
+        edges.append(min(n_max, edges[-1] + min(longest_n, max(shortest_n, int(resolution * edges[-1])))))
+    return np.array(edges)
+
+
+def linear_channels(gyro_unbiased: Any, roll: float, pitch: float, level_force: Any) -> tuple[float, ...]:
+    """Euler rates u = T(φ, θ) ω [rad/s] from the bias-corrected body rate ω (3,), then the
+    linearised level specific force a_h + g [θ, −φ, 0] [m/s²] from the level frame's
+    acceleration ``level_force`` (3,) (surge, sway, heave axes; module docstring)."""
+    p, q, r = gyro_unbiased
+    sf, cf = math.sin(roll), math.cos(roll)
+    qr = q * sf + r * cf
+    return (p + qr * math.tan(pitch), q * cf - r * sf, qr / math.cos(pitch),
+            level_force[0] + G * pitch, level_force[1] - G * roll, level_force[2])
+
+
+class JointMotion:
+    """The joint motion filter (module docstring).
+
+    Parameters
+    ----------
+    memory : float
+        Span of the rows [s].
+    dt : float
+        Sample interval [s].
+    lag_steps : int
+        Delay of the teacher's outputs [samples].
+    forget : float
+        Time constant of the fit's forgetting [s].
+    """
+
+    def __init__(self, memory: float, dt: float, lag_steps: int, forget: float) -> None:
+        self.dt = dt
+        self.lag = lag_steps
+        self.edges = block_edges(memory, dt, shortest=SHORTEST_BLOCK)
+        self.lengths = np.diff(self.edges).astype(float)
+        self.blocks = len(self.lengths)
+        self.n = int(self.edges[-1]) + lag_steps + 2          # ring rows: the memory and the lag
+        self.ages = self.n - self.edges                       # + the newest row: the edges' rows
+        self.features_count = CHANNELS * self.blocks + 1
+        self.stride = max(1, int(round(STRIDE / dt)))
+        self.refit_steps = max(1, int(round(REFIT / dt)))
+        self.warmup_rows = WARMUP_RATIO * self.features_count
+        self.decay = math.exp(-REFIT / forget)
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the initial state (nothing taught)."""
+        self.k = 0
+        self.ring = np.zeros((2 * self.n, CHANNELS))
+        self.totals = (0.0,) * CHANNELS            # the channels' running sums
+        self.angles = (0.0, 0.0, 0.0)              # the Euler rates' integral [rad]
+        self.last_rates: tuple[float, float, float] | None = None
+        self.last_bad = -1 << 40                  # the newest step with a bad sample
+        self.batch: list[np.ndarray] = []
+        self.batch_targets: list[np.ndarray] = []
+        self.normal = np.zeros((self.features_count, self.features_count))
+        self.moment = np.zeros((self.features_count, TARGETS))
+        self.rows = 0.0                            # the forgotten count of taught rows
+        self.weights: np.ndarray | None = None     # (features, 6) W
+        self.node_weights = np.zeros((TARGETS, len(self.edges) * CHANNELS))   # Vᵀ, rows contiguous
+        self.constant = np.zeros(TARGETS)
+        self.index = np.zeros(len(self.edges), dtype=np.intp)
+        self.nodes = np.zeros((len(self.edges), CHANNELS))
+        self.flat_nodes = self.nodes.reshape(-1)           # a view: the gather lands in it
+
+    @property
+    def ready(self) -> bool:
+        """Whether a fit exists."""
+        return self.weights is not None
+
+    def push(self, channels: tuple[float, ...] | None) -> None:
+        """One sample of the six linear channels (:func:`linear_channels`), or None for a bad
+        sample (the rates and forces enter as zero and no row spanning it is taught)."""
+        if channels is None:
+            self.last_bad = self.k
+            channels = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        u0, u1, u2, f0, f1, f2 = channels
+        l0, l1, l2 = self.last_rates or (u0, u1, u2)
+        self.last_rates = (u0, u1, u2)
+        h = 0.5 * self.dt
+        a0, a1, a2 = self.angles
+        a0 += h * (l0 + u0)
+        a1 += h * (l1 + u1)
+        a2 += h * (l2 + u2)
+        self.angles = (a0, a1, a2)
+        t0, t1, t2, t3, t4, t5, t6, t7, t8 = self.totals
+        t = self.totals = (t0 + a0, t1 + a1, t2 + a2, t3 + u0, t4 + u1, t5 + u2, t6 + f0, t7 + f1, t8 + f2)
+        i = self.k % self.n
+        ring = self.ring
+        ring[i] = t
+        ring[i + self.n] = t
+        self.k += 1
+
+    def gather(self, age: int = 0) -> np.ndarray:
+        """(B + 1, 9) running sums at the block edges of the row ``age`` samples before the
+        newest, newest edge first."""
+        return self.ring[(self.k - 1 - age) % self.n + self.ages]
+
+    def features(self, age: int = 0) -> np.ndarray:
+        """(F,) row of the sample ``age`` samples before the newest: per block (newest first) the
+        nine channels' means, the angles' less the angles now, then 1."""
+        s = self.gather(age)
+        means = (s[:-1] - s[1:]) / self.lengths[:, None]
+        means[:, :3] -= means[0, :3]
+        return np.append(means.ravel(), 1.0)
+
+    def teach(self, smoothed: np.ndarray | None) -> None:
+        """After :meth:`push`: the teacher's outputs for the sample ``lag`` before the newest,
+        (3, 2) position [m] and rate [m/s] per axis, or None if it has none. A row is taught
+        every :data:`STRIDE` s when its span holds no bad sample; every :data:`REFIT` s the rows
+        are folded into the fit."""
+        k = self.k
+        if (smoothed is not None and k % self.stride == 0 and k - 1 - self.last_bad > self.lag + self.edges[-1]
+                and k > self.lag + self.edges[-1] + 1):
+            self.batch.append(self.features(self.lag))
+            self.batch_targets.append(np.concatenate([smoothed[:, 0], smoothed[:, 1]]))
+        if k % self.refit_steps == 0 and self.batch:
+            self._refit()
+
+    def _refit(self) -> None:
+        """Fold the batch into N and M and solve for W (module docstring)."""
+        x, y = np.array(self.batch), np.array(self.batch_targets)
+        self.batch, self.batch_targets = [], []
+        self.normal *= self.decay
+        self.moment *= self.decay
+        self.normal += x.T @ x
+        self.moment += x.T @ y
+        self.rows = self.decay * self.rows + len(x)
+        if self.rows < self.warmup_rows:
+            return
+        regular = self.normal.copy()
+        regular.flat[::len(regular) + 1] += RIDGE * float(np.mean(np.diag(self.normal)))
+        try:
+            weights = cho_solve(cho_factor(regular, overwrite_a=True, check_finite=False), self.moment)
+        except LinAlgError:
+            return                                      # keep the last fit
+        if np.all(np.isfinite(weights)):
+            self.weights = weights
+            self._fold()
+
+    def _fold(self) -> None:
+        """V and c from W: the prediction as a product with the running sums at the edges.
+
+        With S_a the running sums at age a and L_j the block lengths, block j's mean is
+        (S_{e_j} − S_{e_{j+1}})/L_j and the angles now are block 0's mean (one sample), so
+        Σ_j m_j W_j = Σ_j S_{e_j} (W_j/L_j − W_{j−1}/L_{j−1}) with the angle columns' weight
+        sum moved to the first block."""
+        w = self.weights[:-1].reshape(self.blocks, CHANNELS, TARGETS)
+        scaled = w / self.lengths[:, None, None]
+        v = np.zeros((self.blocks + 1, CHANNELS, TARGETS))
+        v[:-1] += scaled
+        v[1:] -= scaled
+        angle_sum = w[:, :3].sum(axis=0) / self.lengths[0]
+        v[0, :3] -= angle_sum
+        v[1, :3] += angle_sum
+        self.node_weights = np.ascontiguousarray(v.reshape(-1, TARGETS).T)
+        self.constant = self.weights[-1].copy()
+
+    def predict(self) -> np.ndarray:
+        """(2, 3) position [m] and rate [m/s] of surge, sway, heave now (after :meth:`push`), a
+        new array: one gather of the running sums at the edges into a kept buffer, one product."""
+        np.add(self.ages, (self.k - 1) % self.n, out=self.index)
+        np.take(self.ring, self.index, axis=0, out=self.nodes)
+        y = np.dot(self.node_weights, self.flat_nodes)
+        y += self.constant
+        return y.reshape(2, 3)
+
+    def get_state(self) -> dict:
+        """JSON-serialisable state."""
+        return {"k": self.k, "ring": self.ring.tolist(), "totals": list(self.totals), "angles": list(self.angles),
+                "last_rates": None if self.last_rates is None else list(self.last_rates),
+                "last_bad": self.last_bad, "batch": np.array(self.batch).tolist(),
+                "batch_targets": np.array(self.batch_targets).tolist(), "normal": self.normal.tolist(),
+                "moment": self.moment.tolist(), "rows": self.rows,
+                "weights": None if self.weights is None else self.weights.tolist()}
+
+    def set_state(self, s: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.reset()
+        self.k, self.last_bad, self.rows = int(s["k"]), int(s["last_bad"]), float(s["rows"])
+        self.ring = np.array(s["ring"], dtype=float).reshape(2 * self.n, CHANNELS)
+        self.totals = tuple(float(v) for v in s["totals"])
+        self.angles = tuple(float(v) for v in s["angles"])
+        self.last_rates = None if s["last_rates"] is None else tuple(float(v) for v in s["last_rates"])
+        self.batch = list(np.array(s["batch"], dtype=float).reshape(-1, self.features_count))
+        self.batch_targets = list(np.array(s["batch_targets"], dtype=float).reshape(-1, TARGETS))
+        self.normal = np.array(s["normal"], dtype=float)
+        self.moment = np.array(s["moment"], dtype=float)
+        if s["weights"] is not None:
+            self.weights = np.array(s["weights"], dtype=float)
+            self._fold()
