@@ -82,7 +82,8 @@ class LibcosimBeside:
 
 
 class Driver:
-    """One FMU instance driven step by step through FMPy's FMU2Slave (DT = 0.01 s)."""
+    """One FMU instance driven step by step through FMPy's FMU2Slave (steps of DT = 0.01 s
+    unless a step says otherwise)."""
 
     def __init__(self, path, tmp, name):
         self.md = read_model_description(str(path))
@@ -99,9 +100,9 @@ class Driver:
         self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
 
-    def step(self, k, inputs, outputs, booleans=("valid",)):
+    def step(self, k, inputs, outputs, booleans=("valid",), dt=DT):
         self.fmu.setReal([self.vr[n].valueReference for n in inputs], list(inputs.values()))
-        status = self.fmu.doStep(currentCommunicationPoint=k * DT, communicationStepSize=DT)
+        status = self.fmu.doStep(currentCommunicationPoint=k * dt, communicationStepSize=dt)
         reals = self.fmu.getReal([self.vr[n].valueReference for n in outputs])
         return status, reals, self.fmu.getBoolean([self.vr[n].valueReference for n in booleans])
 

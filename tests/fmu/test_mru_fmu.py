@@ -49,3 +49,27 @@ def test_mru_fmu_equals_in_process(fmu_dir, tmp_path):
     assert flags[:3] == [True, True, True]
     assert abs(reals[OUTS.index("mp2.heave")] - reals[OUTS.index("heave")]) > 1e-3   # the point is not the IMU
     f.close()
+
+
+@pytest.mark.fmu
+def test_the_taught_joint_filter_runs_in_the_fmu_as_in_process(fmu_dir, tmp_path):
+    """At 10 Hz with a 10 s joint memory the joint filter is taught within 500 s; from then on
+    the FMU's outputs are the in-process unit's, bit for bit, and ``motion.joint`` says so."""
+    dt, every = 0.1, 10
+    rec = case_record("polar_supply", 3.0, 10.0, "cog", duration=500.0)
+    gyro, acc = stack(rec, "imu.gyro")[::every], stack(rec, "imu.acc")[::every]
+    params = {"window": 45.0, "omega_min": 0.3, "delayed_lag": 5.0, "joint_memory": 10.0}
+    f = Driver(fmu_dir / "MotionReferenceUnit.fmu", tmp_path, "mru_joint")
+    f.init(params)
+    model = MotionReferenceUnit(mru_params(params))
+    outs = ["surge", "sway", "heave", "surge_rate", "sway_rate", "heave_rate"]
+    joint_steps = 0
+    for k in range(len(acc)):
+        inputs = {**{f"gyro.{x}": float(v) for x, v in zip("xyz", gyro[k])},
+                  **{f"acc.{x}": float(v) for x, v in zip("xyz", acc[k])}}
+        _, reals, flags = f.step(k, inputs, outs, ("motion.joint",), dt=dt)
+        r = model.step(gyro[k], acc[k], dt)
+        assert reals == [*r.position[0], *r.velocity[0]] and flags == [r.joint], k
+        joint_steps += r.joint
+    assert joint_steps > 200
+    f.close()

@@ -2,9 +2,12 @@
 only, against VesselMotion's truth, beside the datasheets of commercial units.
 
 The grid is the ``defaults`` part's (:data:`~.defaults.CASES`: the three vessel presets × the
-three benchmark seas × the IMU at the COG and far from it), default MEMS IMU, one seed, 600 s,
-scored from :data:`~.defaults.SETTLE` s or the first valid sample, whichever is later. The
-monitoring points (:data:`POINTS`, relative to the IMU, body frame) reach 59.8 m from the IMU.
+three benchmark seas × the IMU at the COG and far from it), default MEMS IMU, one seed,
+:data:`DURATION` s, scored from the first sample the joint filter gives (``motion.joint``; at
+the defaults and 100 Hz after about 15 minutes) or, if it never does, from
+:data:`~.defaults.SETTLE` s or the first valid sample, whichever is later: the goals are the
+unit's accuracy once settled, as a datasheet's. The monitoring points (:data:`POINTS`, relative
+to the IMU, body frame) reach 59.8 m from the IMU.
 
 Each figure is an RMS error with the truth's and the error's means removed (motion about the
 mean position; the filters have no output at zero frequency), against the truth's standard
@@ -25,6 +28,11 @@ from ..estimators.mru.unit import AXES, MotionReferenceUnit
 from ..frames import rot_nb
 from ..sea.motion_model import stack
 from .defaults import CASES, DT, SETTLE, case_record
+
+#: Length of each case's record [s]: the joint filter's first fit (two rows per weight, 640 s of
+#: taught rows at the defaults, after the axis filters' first delayed output at about 175 s) and
+#: then 15 minutes scored.
+DURATION = 1800.0
 
 #: Monitoring points relative to the IMU, body frame [m]: a point near the IMU, one aft and to
 #: port, one high on the beam, and one 59.8 m forward and above (a crane or gangway tip on the
@@ -53,12 +61,12 @@ def run_mru(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams) -> di
     n, rows = len(acc), len(params.points) + 1
     out = {"roll": np.empty(n), "pitch": np.empty(n), "position": np.empty((n, rows, 3)),
            "velocity": np.empty((n, rows, 3)), "delayed": np.empty((n, rows, 3)), "valid": np.empty(n, bool),
-           "delayed_valid": np.empty(n, bool)}
+           "delayed_valid": np.empty(n, bool), "joint": np.empty(n, bool)}
     for k in range(n):
         r = mru.step(gyro[k], acc[k], DT)
         out["roll"][k], out["pitch"][k] = r.roll, r.pitch
         out["position"][k], out["velocity"][k], out["delayed"][k] = r.position, r.velocity, r.delayed_position
-        out["valid"][k], out["delayed_valid"][k] = r.motion_valid, r.delayed_valid
+        out["valid"][k], out["delayed_valid"][k], out["joint"][k] = r.motion_valid, r.delayed_valid, r.joint
     out["delay"] = np.array(mru.delay)
     return out
 
@@ -98,14 +106,21 @@ def goals(std_cm: np.ndarray) -> np.ndarray:
     return np.maximum(2.0, std_cm * np.array([0.05, 0.05, 0.025]))
 
 
-def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None = None) -> dict:
+def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None = None,
+             duration: float = DURATION) -> dict:
     """One case: the real-time and delayed errors [cm] at the IMU and each point of
-    :data:`POINTS` per axis, the truth's std, the goals, and roll and pitch [deg]."""
-    rec = case_record(preset, hs, tp, place, extra=extra)
+    :data:`POINTS` per axis, the truth's std, the goals, roll and pitch [deg], and the IMU's
+    real-time errors with the axis filters alone (``motion_model = "axis"``) and with those fed
+    the true attitude; scored from ``scored_from_s`` (module docstring)."""
+    rec = case_record(preset, hs, tp, place, duration=duration, extra=extra)
     out = run_mru(rec, MotionReferenceUnitParams(points=POINTS))
     if not out["valid"].any():        # no sea above the noise the filters assume: no motion output
         return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "valid": False}
     k0 = max(int(SETTLE / DT), int(np.argmax(out["valid"])))
+    if out["joint"].any():
+        k0 = max(k0, int(np.argmax(out["joint"])))
+    axis = run_mru(rec, MotionReferenceUnitParams(motion_model="axis"))
+    imu, _ = point_truth(rec, (0.0, 0.0, 0.0))
     lag = int(round(float(out["delay"]) / DT))
     rows = []
     for j, arm in enumerate(((0.0, 0.0, 0.0), *POINTS)):
@@ -122,7 +137,8 @@ def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None =
     roll = np.degrees(np.sqrt(np.mean(np.angle(np.exp(1j * (out["roll"][k0:] - rec["truth.roll"][k0:]))) ** 2)))
     pitch = np.degrees(np.sqrt(np.mean((out["pitch"][k0:] - rec["truth.pitch"][k0:]) ** 2)))
     return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "valid": True, "roll_deg": float(roll),
-            "pitch_deg": float(pitch),
+            "pitch_deg": float(pitch), "scored_from_s": k0 * DT, "joint": bool(out["joint"][k0:].all()),
+            "axis_imu_cm": (100 * rms_about_mean(axis["position"][k0:, 0] - imu[k0:])).tolist(),
             "delay_s": float(out["delay"]), "points": rows,
             "true_attitude_imu_cm": true_attitude_cm(rec, MotionReferenceUnitParams(points=POINTS), k0)}
 
@@ -133,7 +149,7 @@ def print_mru(rows: list[dict]) -> dict:
           "(real-time / delayed) per axis against the goal; worst point of each case")
     print(f"{'vessel':<13} {'Hs':>4} {'Tp':>4} {'IMU':<4} {'roll/pitch deg':>15} "
           + " ".join(f"{a + ' rt/dl/goal':>20}" for a in AXES)
-          + "\n(second line: at the IMU, and the three filters fed the true attitude, real time)")
+          + "\n(second line: at the IMU; the axis filters alone, and fed the true attitude, real time)")
     over, delayed_over = 0, 0
     rows = [{**r, "points": [{k: np.asarray(v) for k, v in p.items()} for p in r["points"]]} for r in rows]
     for r in rows:
@@ -144,7 +160,9 @@ def print_mru(rows: list[dict]) -> dict:
         imu = r["points"][0]
         at_imu = [f"{imu['rt_cm'][i]:.2f}/{imu['delayed_cm'][i]:.2f}/{imu['goal_cm'][i]:.2f}" for i in range(3)]
         print(f"{'':<13} {'':>4} {'':>4} {'':<4} {'at the IMU':>15} " + " ".join(f"{c:>20}" for c in at_imu)
-              + "   true attitude " + "/".join(f"{x:.2f}" for x in r["true_attitude_imu_cm"]))
+              + "   axis filters " + "/".join(f"{x:.2f}" for x in r["axis_imu_cm"])
+              + "   true attitude " + "/".join(f"{x:.2f}" for x in r["true_attitude_imu_cm"])
+              + f"   scored from {r['scored_from_s']:.0f} s" + ("" if r["joint"] else " (no joint filter)"))
         over += any(np.any(p["rt_cm"] > p["goal_cm"]) for p in r["points"])
         delayed_over += any(np.any(p["delayed_cm"] > 0.5 * p["rt_cm"]) for p in r["points"])
     print(f"real-time over its goal on {over} of {len(rows)} cases; delayed above half the real-time error on "
@@ -183,11 +201,13 @@ def replay_filters(fed: list[list[float | None]], params: MotionReferenceUnitPar
     return [push(values) for values in fed]
 
 
-def cost_per_step(steps: int = 30000) -> dict[str, float]:
+def cost_per_step(steps: int = 30000, warm: int = 100000) -> dict[str, float]:
     """In-process µs per step of the MotionReferenceUnit with the four :data:`POINTS` and with
     none, the AttitudeEstimator and the HeaveObserver at their defaults, on the first case's
-    record (best of two runs each, the four models taking turns; the design and bias-step work
-    amortised over the run, which spans two designs per axis).
+    record: each model runs ``warm`` steps untimed (1000 s at 100 Hz: the joint filter taught,
+    every spectrum window at its longest) and then ``steps`` timed (best of two runs each, the
+    models taking turns; the design, refit and bias-step work amortised over the timed steps,
+    which span five designs per axis and two refits).
 
     The budget is the AttitudeEstimator's plus 1.5 × the HeaveObserver's. The unit without
     points is what the budget compares: the attitude and the motion at the IMU (three axis
@@ -204,7 +224,7 @@ def cost_per_step(steps: int = 30000) -> dict[str, float]:
     from ..estimators.attitude.estimator import AttitudeEstimator
     from ..estimators.heave.observer import HeaveObserver
 
-    rec = case_record(*CASES[0][:4], duration=steps * DT)
+    rec = case_record(*CASES[0][:4], duration=(warm + steps) * DT)
     gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
     roll, pitch = rec["truth.roll"], rec["truth.pitch"]
 
@@ -213,6 +233,8 @@ def cost_per_step(steps: int = 30000) -> dict[str, float]:
 
     models = {"mru_us": (lambda: MotionReferenceUnit(MotionReferenceUnitParams(points=POINTS), quiet=True), imu_step),
               "mru_no_points_us": (lambda: MotionReferenceUnit(quiet=True), imu_step),
+              "mru_axis_us": (lambda: MotionReferenceUnit(MotionReferenceUnitParams(motion_model="axis"), quiet=True),
+                              imu_step),
               "attitude_us": (AttitudeEstimator, imu_step),
               "heave_us": (lambda: HeaveObserver(quiet=True), lambda m, k: m.step(acc[k], roll[k], pitch[k], DT))}
     fed, _ = filter_feed(gyro, acc, MotionReferenceUnitParams())
@@ -224,14 +246,19 @@ def cost_per_step(steps: int = 30000) -> dict[str, float]:
 
     models["filters_us"] = (fresh_filters, lambda group, k: group.push(fed[k]))
     best = dict.fromkeys(models, math.inf)
+    taught = True
     for _ in range(2):
         for name, (make, run) in models.items():
             model = make()
+            for k in range(warm):
+                run(model, k)
+            if name.startswith("mru_") and name != "mru_axis_us":
+                taught = taught and model.joint is not None and model.joint.ready
             t = time.perf_counter()
-            for k in range(steps):
+            for k in range(warm, warm + steps):
                 run(model, k)
             best[name] = min(best[name], 1e6 * (time.perf_counter() - t) / steps)
-    return {**best, "points_us": best["mru_us"] - best["mru_no_points_us"],
+    return {**best, "joint_taught": taught, "points_us": best["mru_us"] - best["mru_no_points_us"],
             "floor_us": best["attitude_us"] + best["filters_us"],
             "budget_us": best["attitude_us"] + 1.5 * best["heave_us"]}
 
@@ -267,7 +294,8 @@ def mru_bench(progress: bool = True) -> dict:
     print_heave_and_angles(mru_rows)
     cost = cost_per_step()
     print(f"cost per step in-process: MotionReferenceUnit (4 points) {cost['mru_us']:.1f} us, without points "
-          f"{cost['mru_no_points_us']:.1f} us; budget {cost['budget_us']:.1f} us = AttitudeEstimator "
+          f"{cost['mru_no_points_us']:.1f} us, axis filters alone {cost['mru_axis_us']:.1f} us (joint filter "
+          f"{'taught' if cost['joint_taught'] else 'NOT taught'}); budget {cost['budget_us']:.1f} us = AttitudeEstimator "
           f"{cost['attitude_us']:.1f} + 1.5 x HeaveObserver {cost['heave_us']:.1f}; floor {cost['floor_us']:.1f} us "
           f"= the attitude + its three axis filters {cost['filters_us']:.1f}")
     return {"cases": rows, **summary, "mru_grade": mru_rows, "cost": cost}
@@ -277,8 +305,9 @@ def markdown(data: dict) -> str:
     """The docs page's tables from this part's output (``bench.json``'s ``mru``): per case, the
     worst point's real-time / delayed error against the goal per axis, and the IMU's with the
     true attitude; then the ``mru`` grade's angles and farthest-point heave."""
-    lines = ["| vessel | Hs m | Tp s | IMU | roll / pitch ° | surge cm | sway cm | heave cm | IMU, true attitude cm |",
-             "|---|---:|---:|---|---:|---:|---:|---:|---:|"]
+    lines = ["| vessel | Hs m | Tp s | IMU | roll / pitch ° | surge cm | sway cm | heave cm | IMU, axis filters cm "
+             "| IMU, true attitude cm |",
+             "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
     for r in data["cases"]:
         pts = [{k: np.asarray(v) for k, v in p.items()} for p in r["points"]]
         cells = []
@@ -287,8 +316,9 @@ def markdown(data: dict) -> str:
             mark = "" if w["rt_cm"][i] <= w["goal_cm"][i] else " ✗"
             cells.append(f"{w['rt_cm'][i]:.1f} / {w['delayed_cm'][i]:.1f} ({w['goal_cm'][i]:.1f}){mark}")
         true = " / ".join(f"{x:.1f}" for x in r["true_attitude_imu_cm"])
+        axis = " / ".join(f"{x:.1f}" for x in r["axis_imu_cm"])
         lines.append(f"| {r['preset']} | {r['hs']:g} | {r['tp']:g} | {r['imu']} | {r['roll_deg']:.3f} / "
-                     f"{r['pitch_deg']:.3f} | {' | '.join(cells)} | {true} |")
+                     f"{r['pitch_deg']:.3f} | {' | '.join(cells)} | {axis} | {true} |")
     lines += ["", "| vessel, `imu.grade = mru` | Hs m | Tp s | roll / pitch ° | heave at 59.8 m cm (goal) |",
               "|---|---:|---:|---:|---:|"]
     for r in data.get("mru_grade", []):

@@ -214,3 +214,29 @@ def test_the_scalar_low_pass_and_the_location_map_repeat_the_general_ones():
     rot, imu = rot_nb(0.05, -0.02, 0.3), np.array([0.4, -0.7, 1.2])
     at = (np.concatenate([(rot - np.eye(3)).ravel(), imu]) @ location_map(arms)).reshape(3, 3)
     np.testing.assert_allclose(at, np.vstack([imu, imu + arms @ rot.T - arms]), rtol=0, atol=1e-13)
+
+
+@pytest.fixture(scope="module")
+def high_sea():
+    """polar_supply in Hs 6 m / Tp 14 s, IMU at the COG, 1200 s: the joint filter's first fit
+    comes at about 840 s (two taught rows per weight after the first delayed output)."""
+    rec = case_record("polar_supply", 6.0, 14.0, "cog", duration=1200.0)
+    return rec, run_mru(rec, MotionReferenceUnitParams()), run_mru(rec, MotionReferenceUnitParams(motion_model="axis"))
+
+
+def test_the_joint_filter_meets_the_goals_at_the_imu_where_the_axis_filters_miss(high_sea):
+    """Once taught (``joint``, from 840 s), the real-time surge, sway and heave at the IMU are
+    within max(2 cm, 5 %) and max(2 cm, 2.5 %) of the truth's std (std 83 / 91 / 151 cm, goals
+    4.1 / 4.5 / 3.8 cm; measured 3.5 / 3.2 / 2.6 cm); the axis filters alone, over the same
+    samples, miss surge and sway by more than half again (6.8 / 8.9 cm: the attitude's tilt error,
+    module docstring of ``marinefmu.estimators.mru.joint``). Before the fit the unit's outputs
+    are the axis filters' own."""
+    rec, joint, axis = high_sea
+    k0 = int(np.argmax(joint["joint"]))
+    assert joint["joint"][k0:].all() and 700.0 <= k0 * DT <= 900.0
+    np.testing.assert_array_equal(joint["position"][:k0], axis["position"][:k0])
+    goal = np.array([0.05, 0.05, 0.025])
+    rt, _, std = errors_cm(rec, joint, 0, (0.0, 0.0, 0.0), k0)
+    rt_axis, _, _ = errors_cm(rec, axis, 0, (0.0, 0.0, 0.0), k0)
+    assert np.all(rt <= np.maximum(2.0, goal * std)), (rt, std)
+    assert np.all(rt_axis[:2] > 1.5 * np.maximum(2.0, goal[:2] * std[:2])), rt_axis

@@ -35,7 +35,8 @@ samples after it), so the fit converges to the smoothed motion's causal part, no
 **Per step** the filter writes the channels' running sums to a ring (each row twice, so that any
 age is one index) and reads the running sums at the block edges: the prediction is linear in them,
 y = Σ_a S_{k−a} V_a + c, with V folded from W at each refit (:meth:`JointMotion._fold`), one
-gather and one product. Until the first fit (:data:`WARMUP_RATIO` taught rows per weight) it
+gather and one product. After the first fit the unit moves its outputs from the axis filters'
+to these over :data:`BLEND` s (:meth:`JointMotion.share`). Until the first fit (:data:`WARMUP_RATIO` taught rows per weight) it
 gives nothing and the unit keeps its axis filters' outputs.
 
 Hand-written least squares (numpy and ``scipy.linalg.cho_factor``): neither scipy, filterpy nor
@@ -66,6 +67,10 @@ REFIT = 120.0
 #: errors (2 × 640 rows, 640 s at the defaults and 100 Hz: the first fit's errors are then those
 #: of the later ones; after 300 s they were up to 1.9 × the axis filters' in heave).
 WARMUP_RATIO = 2.0
+#: After the first fit the unit's outputs move from the axis filters' to the joint filter's
+#: linearly over BLEND s [s], so that the first fit does not step them (by a few centimetres,
+#: which a heave compensator's feedforward would pass to its winch as a jerk).
+BLEND = 10.0
 #: Ridge, relative to the normal matrix's mean diagonal.
 RIDGE = 1e-7
 #: Number of channels: angle changes (3), Euler rates (3), specific force (3).
@@ -142,7 +147,9 @@ class JointMotion:
         self.normal = np.zeros((self.features_count, self.features_count))
         self.moment = np.zeros((self.features_count, TARGETS))
         self.rows = 0.0                            # the forgotten count of taught rows
+        self.taught = 0                            # every row taught
         self.weights: np.ndarray | None = None     # (features, 6) W
+        self.fitted_at: int | None = None          # the sample count at the first fit
         self.node_weights = np.zeros((TARGETS, len(self.edges) * CHANNELS))   # Vᵀ, rows contiguous
         self.constant = np.zeros(TARGETS)
         self.index = np.zeros(len(self.edges), dtype=np.intp)
@@ -212,7 +219,8 @@ class JointMotion:
         self.normal += x.T @ x
         self.moment += x.T @ y
         self.rows = self.decay * self.rows + len(x)
-        if self.rows < self.warmup_rows:
+        self.taught += len(x)
+        if self.taught < self.warmup_rows:
             return
         regular = self.normal.copy()
         regular.flat[::len(regular) + 1] += RIDGE * float(np.mean(np.diag(self.normal)))
@@ -223,6 +231,8 @@ class JointMotion:
         if np.all(np.isfinite(weights)):
             self.weights = weights
             self._fold()
+            if self.fitted_at is None:
+                self.fitted_at = self.k
 
     def _fold(self) -> None:
         """V and c from W: the prediction as a product with the running sums at the edges.
@@ -242,6 +252,13 @@ class JointMotion:
         self.node_weights = np.ascontiguousarray(v.reshape(-1, TARGETS).T)
         self.constant = self.weights[-1].copy()
 
+    def share(self) -> float:
+        """Weight of the joint filter in the unit's outputs, 0 … 1: 0 until the first fit, then
+        rising linearly to 1 over :data:`BLEND` s."""
+        if self.fitted_at is None:
+            return 0.0
+        return min(1.0, (self.k - self.fitted_at) * self.dt / BLEND)
+
     def predict(self) -> np.ndarray:
         """(2, 3) position [m] and rate [m/s] of surge, sway, heave now (after :meth:`push`), a
         new array: one gather of the running sums at the edges into a kept buffer, one product."""
@@ -257,13 +274,15 @@ class JointMotion:
                 "last_rates": None if self.last_rates is None else list(self.last_rates),
                 "last_bad": self.last_bad, "batch": np.array(self.batch).tolist(),
                 "batch_targets": np.array(self.batch_targets).tolist(), "normal": self.normal.tolist(),
-                "moment": self.moment.tolist(), "rows": self.rows,
+                "moment": self.moment.tolist(), "rows": self.rows, "taught": self.taught, "fitted_at": self.fitted_at,
                 "weights": None if self.weights is None else self.weights.tolist()}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
         self.reset()
         self.k, self.last_bad, self.rows = int(s["k"]), int(s["last_bad"]), float(s["rows"])
+        self.taught = int(s["taught"])
+        self.fitted_at = None if s["fitted_at"] is None else int(s["fitted_at"])
         self.ring = np.array(s["ring"], dtype=float).reshape(2 * self.n, CHANNELS)
         self.totals = tuple(float(v) for v in s["totals"])
         self.angles = tuple(float(v) for v in s["angles"])

@@ -16,6 +16,15 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    parameters; their spectra and filters are their own, and their designs reject the
    acceleration below ``omega_min`` (the attitude's slow tilt error times g), so they have no
    bias-step search (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`).
+   **Joint filter** (``motion_model = "joint"``, the default; :mod:`.joint`): once it has two
+   taught rows per weight (about 14 minutes at the defaults and 100 Hz), the real-time surge,
+   sway and heave at the IMU and their rates come instead from one causal linear filter of all
+   six IMU channels' past, fitted to the three axis filters' delayed outputs; the outputs move
+   over to it in :data:`~.joint.BLEND` s. Its rows do not carry the attitude's tilt error and
+   read every channel, so in a sea where one wave train drives all six motions it errs 2-3 ×
+   less than the axis filters in surge and sway. ``motion_model = "axis"`` keeps the axis
+   filters' real-time outputs (paper 003's observer per axis). The delayed outputs are the
+   axis filters' either way.
 4. **Monitoring points**: each adds its lever arm's motion about its mean, R r − ⟨R r⟩ with
    R = Rz(ψ_w) Ry(θ) Rx(φ), and its rate and acceleration (:mod:`.level_frame`), the exact
    rigid-body transfer (paper 003 eqs. 10-11 generalised to three axes and a 3-D lever arm).
@@ -33,7 +42,8 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    in the level frame of the mean heading either way.
 
 What runs when: every step, the attitude, the level frame's rows and a_h on Python floats
-(:func:`~.level_frame.level_rows`), each filter's ring writes and the four filters' outputs
+(:func:`~.level_frame.level_rows`), the joint filter's ring write and, once fitted, its one
+gather and product, each filter's ring writes and the four filters' outputs
 as one batched product (:class:`~marinefmu.estimators.heave.wiener.WienerGroup`), and the
 points' arms: the nine entries of R − I and their slow mean on floats, one (2 × W)·(W × 9)
 product on a contiguous slice of their ring (stored twice for it) for the rates and
@@ -43,7 +53,8 @@ read-only zeros;
 every second, the heave filter's bias-step search;
 first after ``motion.window`` s and then every :data:`DESIGN_ROUNDS` × ``motion.peak_interval``
 s, each filter's Wiener design, the four a quarter of an interval apart (on average one
-design per interval in all, as the HeaveObserver), so that no step designs more than one.
+design per interval in all, as the HeaveObserver), so that no step designs more than one; every :data:`~.joint.REFIT` s the joint filter's refit
+(a Cholesky solve of its normal equations).
 
 Bad samples (NaN, Inf, absurd; the AttitudeEstimator's checks): the attitude coasts on the last
 good sample, each axis takes the window's mean acceleration (its estimate decays rather than
@@ -274,6 +285,9 @@ class MotionReferenceUnit:
             joint.teach(out[:3, 2:4] if delayed_valid else None)
             if joint.ready:
                 now = joint.predict()
+                share = joint.share()
+                if share < 1.0:                    # moving over from the axis filters' outputs
+                    now = share * now + (1.0 - share) * out[:3, :2].T
         if not points:                             # the IMU's row only: views of this step's own outputs
             if now is None:
                 position, velocity = out[None, :3, 0], out[None, :3, 1]
