@@ -53,10 +53,10 @@ def test_mru_fmu_equals_in_process(fmu_dir, tmp_path):
 
 @pytest.mark.fmu
 def test_the_taught_joint_filter_runs_in_the_fmu_as_in_process(fmu_dir, tmp_path):
-    """At 10 Hz with a 10 s joint memory the joint filter is taught within 500 s; from then on
-    the FMU's outputs are the in-process unit's, bit for bit, and ``motion.joint`` says so."""
+    """At 10 Hz with a 10 s joint memory the joint filter is taught within 500 s (its first fit
+    at the refit after 352 s of taught rows); from then on the FMU's outputs are the in-process unit's, bit for bit, and ``motion.joint`` says so."""
     dt, every = 0.1, 10
-    rec = case_record("polar_supply", 3.0, 10.0, "cog", duration=500.0)
+    rec = case_record("polar_supply", 3.0, 10.0, "cog", duration=600.0)
     gyro, acc = stack(rec, "imu.gyro")[::every], stack(rec, "imu.acc")[::every]
     params = {"window": 45.0, "omega_min": 0.3, "delayed_lag": 5.0, "joint_memory": 10.0}
     f = Driver(fmu_dir / "MotionReferenceUnit.fmu", tmp_path, "mru_joint")
@@ -71,5 +71,5 @@ def test_the_taught_joint_filter_runs_in_the_fmu_as_in_process(fmu_dir, tmp_path
         r = model.step(gyro[k], acc[k], dt)
         assert reals == [*r.position[0], *r.velocity[0]] and flags == [r.joint], k
         joint_steps += r.joint
-    assert joint_steps > 200
+    assert joint_steps >= 1000
     f.close()

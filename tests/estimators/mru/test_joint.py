@@ -41,6 +41,14 @@ def test_the_folded_prediction_is_the_rows_times_the_weights():
     np.testing.assert_allclose(joint.predict(), expected, rtol=1e-10, atol=1e-10)
 
 
+def teacher(target: np.ndarray) -> np.ndarray:
+    """The axis filters' (3, 4) outputs whose delayed position and rate (columns 2, 3) are
+    ``target`` (6,): position (3), then rate (3)."""
+    out = np.full((3, 4), np.nan)
+    out[:, 2:] = target.reshape(2, 3).T
+    return out
+
+
 def taught(channels: np.ndarray, targets: np.ndarray, bad: int | None = None) -> tuple[JointMotion, list]:
     """A filter fed ``channels`` and taught ``targets`` ``LAG`` samples late; its predictions
     once it has a fit."""
@@ -49,7 +57,7 @@ def taught(channels: np.ndarray, targets: np.ndarray, bad: int | None = None) ->
     for k, x in enumerate(channels):
         joint.push(None if k == bad else tuple(x))
         if k >= LAG:
-            joint.teach(targets[k - LAG].reshape(2, 3).T)
+            joint.teach(teacher(targets[k - LAG]), True)
         if joint.ready:
             predictions.append((k, joint.predict()))
     return joint, predictions
@@ -96,7 +104,7 @@ def test_a_restored_state_continues_identically():
             copy.set_state(json.loads(json.dumps(joint.get_state())))
         for j in (joint, copy) if copy else (joint,):
             j.push(tuple(row))
-            j.teach(targets[k - LAG].reshape(2, 3).T)
+            j.teach(teacher(targets[k - LAG]), k >= LAG)
         if copy:
             np.testing.assert_array_equal(copy.predict(), joint.predict())
 

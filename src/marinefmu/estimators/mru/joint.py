@@ -32,8 +32,8 @@ axis filters' longest spectrum window (``window_max``), solved by Cholesky (``sc
 smoother's own error is mostly not a linear function of the rows at t − lag (it depends on the
 samples after it), so the fit converges to the smoothed motion's causal part, not to its error.
 
-**Per step** the filter writes the channels' running sums to a ring (each row twice, so that any
-age is one index) and reads the running sums at the block edges: the prediction is linear in them,
+**Per step** the filter writes the channels' running sums to a ring and reads (wrapped) the
+running sums at the block edges: the prediction is linear in them,
 y = Σ_a S_{k−a} V_a + c, with V folded from W at each refit (:meth:`JointMotion._fold`), one
 gather and one product. After the first fit the unit moves its outputs from the axis filters'
 to these over :data:`BLEND` s (:meth:`JointMotion.share`). Until the first fit (:data:`WARMUP_RATIO` taught rows per weight) it
@@ -126,7 +126,7 @@ class JointMotion:
         self.lengths = np.diff(self.edges).astype(float)
         self.blocks = len(self.lengths)
         self.n = int(self.edges[-1]) + lag_steps + 2          # ring rows: the memory and the lag
-        self.ages = self.n - self.edges                       # + the newest row: the edges' rows
+        self.ages = -self.edges                               # + the newest row, wrapped: the edges' rows
         self.features_count = CHANNELS * self.blocks + 1
         self.stride = max(1, int(round(STRIDE / dt)))
         self.refit_steps = max(1, int(round(REFIT / dt)))
@@ -137,7 +137,8 @@ class JointMotion:
     def reset(self) -> None:
         """Back to the initial state (nothing taught)."""
         self.k = 0
-        self.ring = np.zeros((2 * self.n, CHANNELS))
+        self.ring = np.zeros((self.n, CHANNELS))
+        self.until_row = self.stride                # samples to the next taught row
         self.totals = (0.0,) * CHANNELS            # the channels' running sums
         self.angles = (0.0, 0.0, 0.0)              # the Euler rates' integral [rad]
         self.last_rates: tuple[float, float, float] | None = None
@@ -150,11 +151,13 @@ class JointMotion:
         self.taught = 0                            # every row taught
         self.weights: np.ndarray | None = None     # (features, 6) W
         self.fitted_at: int | None = None          # the sample count at the first fit
-        self.node_weights = np.zeros((TARGETS, len(self.edges) * CHANNELS))   # Vᵀ, rows contiguous
-        self.constant = np.zeros(TARGETS)
+        # [Vᵀ c]: the running sums' weights, then the constant, which meets the 1 at the end of
+        # the gathered sums (rows contiguous)
+        self.node_weights = np.zeros((TARGETS, len(self.edges) * CHANNELS + 1))
         self.index = np.zeros(len(self.edges), dtype=np.intp)
-        self.nodes = np.zeros((len(self.edges), CHANNELS))
-        self.flat_nodes = self.nodes.reshape(-1)           # a view: the gather lands in it
+        self.flat_nodes = np.ones(len(self.edges) * CHANNELS + 1)      # the gathered sums, then 1
+        self.nodes = self.flat_nodes[:-1].reshape(len(self.edges), CHANNELS)   # a view: the gather lands in it
+        self.blended = False                        # the joint filter's share has reached 1
 
     @property
     def ready(self) -> bool:
@@ -178,16 +181,13 @@ class JointMotion:
         self.angles = (a0, a1, a2)
         t0, t1, t2, t3, t4, t5, t6, t7, t8 = self.totals
         t = self.totals = (t0 + a0, t1 + a1, t2 + a2, t3 + u0, t4 + u1, t5 + u2, t6 + f0, t7 + f1, t8 + f2)
-        i = self.k % self.n
-        ring = self.ring
-        ring[i] = t
-        ring[i + self.n] = t
+        self.ring[self.k % self.n] = t
         self.k += 1
 
     def gather(self, age: int = 0) -> np.ndarray:
         """(B + 1, 9) running sums at the block edges of the row ``age`` samples before the
         newest, newest edge first."""
-        return self.ring[(self.k - 1 - age) % self.n + self.ages]
+        return np.take(self.ring, self.ages + (self.k - 1 - age), axis=0, mode="wrap")
 
     def features(self, age: int = 0) -> np.ndarray:
         """(F,) row of the sample ``age`` samples before the newest: per block (newest first) the
@@ -197,17 +197,20 @@ class JointMotion:
         means[:, :3] -= means[0, :3]
         return np.append(means.ravel(), 1.0)
 
-    def teach(self, smoothed: np.ndarray | None) -> None:
-        """After :meth:`push`: the teacher's outputs for the sample ``lag`` before the newest,
-        (3, 2) position [m] and rate [m/s] per axis, or None if it has none. A row is taught
-        every :data:`STRIDE` s when its span holds no bad sample; every :data:`REFIT` s the rows
-        are folded into the fit."""
+    def teach(self, outputs: np.ndarray, valid: bool) -> None:
+        """After :meth:`push`: the axis filters' (axes, 4) outputs, whose rows 0-2, columns 2-3
+        are the teacher, the position [m] and rate [m/s] of surge, sway and heave ``lag``
+        samples before the newest, if ``valid``. A row is taught every :data:`STRIDE` s when its
+        span holds no bad sample; every :data:`REFIT` s the rows are folded into the fit."""
+        self.until_row -= 1
+        if self.until_row:
+            return
+        self.until_row = self.stride
         k = self.k
-        if (smoothed is not None and k % self.stride == 0 and k - 1 - self.last_bad > self.lag + self.edges[-1]
-                and k > self.lag + self.edges[-1] + 1):
+        if valid and k - 1 - self.last_bad > self.lag + self.edges[-1] and k > self.lag + self.edges[-1] + 1:
             self.batch.append(self.features(self.lag))
-            self.batch_targets.append(np.concatenate([smoothed[:, 0], smoothed[:, 1]]))
-        if k % self.refit_steps == 0 and self.batch:
+            self.batch_targets.append(np.concatenate([outputs[:3, 2], outputs[:3, 3]]))
+        if k % self.refit_steps < self.stride and self.batch:
             self._refit()
 
     def _refit(self) -> None:
@@ -249,24 +252,23 @@ class JointMotion:
         angle_sum = w[:, :3].sum(axis=0) / self.lengths[0]
         v[0, :3] -= angle_sum
         v[1, :3] += angle_sum
-        self.node_weights = np.ascontiguousarray(v.reshape(-1, TARGETS).T)
-        self.constant = self.weights[-1].copy()
+        self.node_weights = np.ascontiguousarray(np.column_stack([v.reshape(-1, TARGETS).T, self.weights[-1]]))
 
     def share(self) -> float:
         """Weight of the joint filter in the unit's outputs, 0 … 1: 0 until the first fit, then
-        rising linearly to 1 over :data:`BLEND` s."""
+        rising linearly to 1 over :data:`BLEND` s (``blended`` from then on)."""
         if self.fitted_at is None:
             return 0.0
-        return min(1.0, (self.k - self.fitted_at) * self.dt / BLEND)
+        share = min(1.0, (self.k - self.fitted_at) * self.dt / BLEND)
+        self.blended = share == 1.0
+        return share
 
     def predict(self) -> np.ndarray:
         """(2, 3) position [m] and rate [m/s] of surge, sway, heave now (after :meth:`push`), a
         new array: one gather of the running sums at the edges into a kept buffer, one product."""
-        np.add(self.ages, (self.k - 1) % self.n, out=self.index)
-        np.take(self.ring, self.index, axis=0, out=self.nodes)
-        y = np.dot(self.node_weights, self.flat_nodes)
-        y += self.constant
-        return y.reshape(2, 3)
+        np.add(self.ages, self.k - 1, out=self.index)
+        np.take(self.ring, self.index, axis=0, out=self.nodes, mode="wrap")
+        return np.dot(self.node_weights, self.flat_nodes).reshape(2, 3)
 
     def get_state(self) -> dict:
         """JSON-serialisable state."""
@@ -275,6 +277,7 @@ class JointMotion:
                 "last_bad": self.last_bad, "batch": np.array(self.batch).tolist(),
                 "batch_targets": np.array(self.batch_targets).tolist(), "normal": self.normal.tolist(),
                 "moment": self.moment.tolist(), "rows": self.rows, "taught": self.taught, "fitted_at": self.fitted_at,
+                "until_row": self.until_row,
                 "weights": None if self.weights is None else self.weights.tolist()}
 
     def set_state(self, s: dict) -> None:
@@ -283,7 +286,8 @@ class JointMotion:
         self.k, self.last_bad, self.rows = int(s["k"]), int(s["last_bad"]), float(s["rows"])
         self.taught = int(s["taught"])
         self.fitted_at = None if s["fitted_at"] is None else int(s["fitted_at"])
-        self.ring = np.array(s["ring"], dtype=float).reshape(2 * self.n, CHANNELS)
+        self.ring = np.array(s["ring"], dtype=float).reshape(self.n, CHANNELS)
+        self.until_row = int(s["until_row"])
         self.totals = tuple(float(v) for v in s["totals"])
         self.angles = tuple(float(v) for v in s["angles"])
         self.last_rates = None if s["last_rates"] is None else tuple(float(v) for v in s["last_rates"])

@@ -282,12 +282,13 @@ class MotionReferenceUnit:
         joint = self.joint
         now = None                                 # the joint filter's (2, 3) position and rate, once taught
         if joint is not None:
-            joint.teach(out[:3, 2:4] if delayed_valid else None)
+            joint.teach(out, delayed_valid)
             if joint.ready:
                 now = joint.predict()
-                share = joint.share()
-                if share < 1.0:                    # moving over from the axis filters' outputs
-                    now = share * now + (1.0 - share) * out[:3, :2].T
+                if not joint.blended:
+                    share = joint.share()
+                    if share < 1.0:                # moving over from the axis filters' outputs
+                        now = share * now + (1.0 - share) * out[:3, :2].T
         if not points:                             # the IMU's row only: views of this step's own outputs
             if now is None:
                 position, velocity = out[None, :3, 0], out[None, :3, 1]
