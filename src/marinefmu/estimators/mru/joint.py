@@ -254,6 +254,10 @@ class JointMotion:
         v[1, :3] += angle_sum
         self.node_weights = np.ascontiguousarray(np.column_stack([v.reshape(-1, TARGETS).T, self.weights[-1]]))
 
+    def clean(self) -> bool:
+        """Whether the newest row's span (the memory) holds no bad sample."""
+        return self.k - 1 - self.last_bad > self.edges[-1]
+
     def share(self) -> float:
         """Weight of the joint filter in the unit's outputs, 0 … 1: 0 until the first fit, then
         rising linearly to 1 over :data:`BLEND` s (``blended`` from then on)."""

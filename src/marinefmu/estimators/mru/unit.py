@@ -4,7 +4,11 @@ Per sample (:meth:`MotionReferenceUnit.step`):
 
 1. **Attitude**: the AttitudeEstimator at its parameters (paper 000 eqs. 6-9 with the aided
    tilt correction; :mod:`marinefmu.estimators.attitude.estimator`) gives R_nb, roll, pitch and
-   the gyro-integrated yaw ψ.
+   the gyro-integrated yaw ψ. Once the joint filter (step 3) has taken over, and while its
+   rows hold no bad sample, its horizontal position and velocity at the IMU are the
+   attitude's aid reference (the estimator's "aid reference"): the aid then tells the tilt's
+   slow drift from the waves to centimetres rather than metres per second, and roll and pitch
+   err 2-3 × less in waves.
 2. **Level frame** (:mod:`.level_frame`): R_hb = Rz(−ψ̄) R_nb, with ψ̄ the slow part of ψ, and
    the IMU's acceleration there, a_h = R_hb f_b + [0, 0, g] (the horizontal specific force after
    tilt compensation).
@@ -163,6 +167,7 @@ class MotionReferenceUnit:
         self.delay_s = 0.0
         self.no_motion = zero_outputs(len(self.arms) + 1)
         self.joint: JointMotion | None = None
+        self.psi_bar = 0.0                            # ψ̄, the level frame's reference yaw [rad]
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -229,7 +234,8 @@ class MotionReferenceUnit:
         values: list[float | None]
         if good:
             self.yaw = att.yaw if self.yaw is None else unwrap(self.yaw, att.yaw)
-            r = self.rot_rows = level_rows(self.yaw_ref.push_one(self.yaw, dt), att.q)
+            self.psi_bar = self.yaw_ref.push_one(self.yaw, dt)
+            r = self.rot_rows = level_rows(self.psi_bar, att.q)
             f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
             heave_acc = r[6] * f0 + r[7] * f1 + r[8] * f2 + G
             values = [r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2, heave_acc]
@@ -283,12 +289,16 @@ class MotionReferenceUnit:
         now = None                                 # the joint filter's (2, 3) position and rate, once taught
         if joint is not None:
             joint.teach(out, delayed_valid)
+            reference = None
             if joint.ready:
                 now = joint.predict()
                 if not joint.blended:
                     share = joint.share()
                     if share < 1.0:                # moving over from the axis filters' outputs
                         now = share * now + (1.0 - share) * out[:3, :2].T
+                elif good and joint.clean():
+                    reference = self._aid_reference(now)
+            self.attitude.aid_reference = reference
         if not points:                             # the IMU's row only: views of this step's own outputs
             if now is None:
                 position, velocity = out[None, :3, 0], out[None, :3, 1]
@@ -316,6 +326,14 @@ class MotionReferenceUnit:
                          heave_axis.peak_period, angles_valid, good, delayed_valid, heading_used, warning,
                          now is not None)
 
+    def _aid_reference(self, now: np.ndarray) -> tuple[float, float, float, float]:
+        """The joint filter's horizontal position and velocity ``now`` (2, 3) [m, m/s, level
+        frame h] turned into the attitude's frame n, Rz(ψ̄) [x, y]: the reference of its next
+        aid (step 1)."""
+        (px, py, _), (vx, vy, _) = now.tolist()
+        c, s = math.cos(self.psi_bar), math.sin(self.psi_bar)
+        return c * px - s * py, s * px + c * py, c * vx - s * vy, s * vx + c * vy
+
     def _heading(self, yaw: float, heading: float | None, heading_valid: bool,
                  dt: float) -> tuple[float, bool, str | None]:
         """Step 5: the yaw output [rad], whether it is north-referenced, and why a heading
@@ -342,7 +360,7 @@ class MotionReferenceUnit:
                 "yaw_ref": self.yaw_ref.get_state(),
                 "turn_mean": self.turn_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
                 "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist(),
-                "joint": None if self.joint is None else self.joint.get_state()}
+                "joint": None if self.joint is None else self.joint.get_state(), "psi_bar": self.psi_bar}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -363,3 +381,4 @@ class MotionReferenceUnit:
         self.turn_ring = np.array(s["turn_ring"], dtype=float).reshape(-1, 9)
         if self.joint is not None and s.get("joint") is not None:
             self.joint.set_state(s["joint"])
+        self.psi_bar = float(s.get("psi_bar", 0.0))
