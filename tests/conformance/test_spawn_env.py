@@ -50,7 +50,13 @@ def test_a_child_given_its_environment_starts_while_another_thread_changes_it():
     assert _spawn_failures(spawn_env) == 0
 
 
+#: Runs of :data:`SPAWNS` before the hazard test gives up: a race, it failed 4-7 of 150 spawns
+#: a run alone and none in one run of the full suite (the other worker's load changes the timing).
+HAZARD_ROUNDS = 10
+
+
 @pytest.mark.skipif(not getattr(subprocess, "_USE_VFORK", False), reason="this Python does not vfork")
 def test_a_child_sharing_the_environment_can_fail_to_start_so_the_first_test_can_fail():
-    """The hazard ``spawn_env`` avoids: with ``env=None`` some children fail with EFAULT."""
-    assert _spawn_failures(lambda: None) > 0
+    """The hazard ``spawn_env`` avoids: with ``env=None`` some children fail with EFAULT, within
+    :data:`HAZARD_ROUNDS` runs (most runs show it; the first that does ends the test)."""
+    assert any(_spawn_failures(lambda: None) > 0 for _ in range(HAZARD_ROUNDS))

@@ -28,16 +28,17 @@ the fit applied to the rows at t. Least squares with a ridge ρ of the mean diag
     N ← λN + X^T X,\\quad M ← λM + X^T Y,\\quad λ = e^{-T/τ},
 
 over the rows of each refit interval T (:data:`REFIT`), forgotten with the time constant τ of the
-axis filters' longest spectrum window (``window_max``), solved by Cholesky (``scipy.linalg``). The
-smoother's own error is mostly not a linear function of the rows at t − lag (it depends on the
-samples after it), so the fit converges to the smoothed motion's causal part, not to its error.
+axis filters' longest spectrum window (``window_max``), solved by Cholesky (``scipy.linalg``).
+Where the smoother's error is not a linear function of the rows at t − lag (it depends on the
+samples after it), the fit does better than its teacher; where it is (the attitude's tilt
+error in the smoothed horizontal motion, an IMU far from the COG), the fit learns it too.
 
 **Per step** the filter writes the channels' running sums to a ring and reads (wrapped) the
 running sums at the block edges: the prediction is linear in them,
 y = Σ_a S_{k−a} V_a + c, with V folded from W at each refit (:meth:`JointMotion._fold`), one
-gather and one product. After the first fit the unit moves its outputs from the axis filters'
-to these over :data:`BLEND` s (:meth:`JointMotion.share`). Until the first fit (:data:`WARMUP_RATIO` taught rows per weight) it
-gives nothing and the unit keeps its axis filters' outputs.
+gather and one product. Until the first fit (:data:`WARMUP_RATIO` taught rows per weight) it
+gives nothing and the unit keeps its axis filters' outputs; after it the unit moves its outputs
+over to these in :data:`BLEND` s (:meth:`JointMotion.share`).
 
 Hand-written least squares (numpy and ``scipy.linalg.cho_factor``): neither scipy, filterpy nor
 python-control fits a multichannel causal filter from data.
