@@ -240,3 +240,22 @@ def test_the_joint_filter_meets_the_goals_at_the_imu_where_the_axis_filters_miss
     rt_axis, _, _ = errors_cm(rec, axis, 0, (0.0, 0.0, 0.0), k0)
     assert np.all(rt <= np.maximum(2.0, goal * std)), (rt, std)
     assert np.all(rt_axis[:2] > 1.5 * np.maximum(2.0, goal[:2] * std[:2])), rt_axis
+
+
+def test_a_state_restored_while_the_joint_filter_runs_continues_bit_identically(high_sea):
+    """Saved at 1000 s (the joint filter fitted, blended and the attitude's aid reference set),
+    through JSON, and restored into a new unit: the next 20 s are the same to the last bit."""
+    rec, _, _ = high_sea
+    gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
+    mru = MotionReferenceUnit(quiet=True)
+    k0 = 100000
+    for k in range(k0):
+        r = mru.step(gyro[k], acc[k], DT)
+    assert r.joint and mru.joint.blended and mru.attitude.aid_reference is not None
+    copy = MotionReferenceUnit(quiet=True)
+    copy.set_state(json.loads(json.dumps(mru.get_state())))
+    for k in range(k0, k0 + 2000):
+        a, b = mru.step(gyro[k], acc[k], DT), copy.step(gyro[k], acc[k], DT)
+        assert (a.roll, a.pitch, a.joint) == (b.roll, b.pitch, b.joint), k
+        np.testing.assert_array_equal(a.position, b.position)
+        np.testing.assert_array_equal(a.velocity, b.velocity)
