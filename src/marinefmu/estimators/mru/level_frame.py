@@ -15,11 +15,16 @@ low-pass removes what the mean position holds while passing the wave-frequency p
 (1/(ω τ))² (0.1 % at 0.3 rad/s). Both terms are linear in R_hb, so every point's d is one
 product (:func:`turn_map`) with the nine entries of (R_hb − I) − ⟨R_hb − I⟩, the one series
 the unit filters and stores.
-Velocity and acceleration add ḋ and d̈, from a causal Savitzky-Golay fit (scipy's
+**Velocity** adds ḋ = Ṙ r with the rigid body's own kinematics, Ṙ_nb = R_nb [ω]×: in the frame
+of the wave-frequency yaw R = Rz(ψ_w) Ry(θ) Rx(φ) (``rot``; the yaw's slow part ψ_s is left
+out), Ṙ = R [ω]× − ψ̇_s [ẑ]× R (:func:`turn_rate_rows`), ω the gyro's rate less its estimated
+bias and ψ̇_s = ψ̇ − ψ̇_w the slow yaw rate. No angle is differentiated: the attitude's
+corrections (its aid's steps) stay out of the rate, which carries only the gyro's own noise
+times the arm. The rate of the slow mean ⟨R − I⟩ is left out (below 1/:data:`~.params.ARM_TAU`).
+**Acceleration** adds d̈, the second derivative of a causal Savitzky-Golay fit (scipy's
 ``savgol_coeffs``) of degree :data:`DERIVATIVE_DEGREE` over the last :data:`DERIVATIVE_WINDOW`
-s, evaluated at the newest sample: a difference of two samples would take the gyro-integrated
-angles' per-sample noise, 60 m × N_gyro/√Δt, for velocity; the fit averages it over the window
-while a wave (period ≥ 5 s) is a quartic over 1 s to within 0.3 % in ḋ.
+s of d, evaluated at the newest sample (a wave of period ≥ 5 s is a quartic over 1 s to within
+0.3 %).
 """
 from __future__ import annotations
 
@@ -30,13 +35,12 @@ from typing import Any
 import numpy as np
 from scipy.signal import savgol_coeffs
 
-#: Length of the Savitzky-Golay fit for the lever arms' rates and accelerations [s]: long
-#: enough to keep the gyro-integrated angles' noise above 2 Hz out of the rate (which a heave
-#: compensator's feedforward passes on to its winch), short enough that a quartic follows a
+#: Length of the Savitzky-Golay fit for the lever arms' accelerations [s]: long enough to keep
+#: the gyro-integrated angles' noise above 2 Hz out, short enough that a quartic follows a
 #: wave (below).
 DERIVATIVE_WINDOW = 1.0
-#: Degree of that fit: over 1 s its endpoint rate errs by 0.03 / 0.27 / 1.5 % at 0.8 / 1.3 /
-#: 2 rad/s (a cubic: 0.6 / 2.5 / 8.9 %).
+#: Degree of that fit: over 1 s its endpoint first derivative errs by 0.03 / 0.27 / 1.5 % at
+#: 0.8 / 1.3 / 2 rad/s (a cubic: 0.6 / 2.5 / 8.9 %).
 DERIVATIVE_DEGREE = 4
 
 
@@ -146,8 +150,22 @@ def unwrap(previous: float, yaw: float) -> float:
     return previous + math.remainder(yaw - previous, 2.0 * math.pi)
 
 
-def derivative_weights(dt: float) -> np.ndarray:
-    """(2, W) weights giving the first and second derivative at the newest of W samples
-    (oldest first) of a cubic fitted over :data:`DERIVATIVE_WINDOW` s (module docstring)."""
+def acceleration_weights(dt: float) -> np.ndarray:
+    """(1, W) weights giving the second derivative at the newest of W samples (oldest first)
+    of a polynomial of degree :data:`DERIVATIVE_DEGREE` fitted over :data:`DERIVATIVE_WINDOW`
+    s (module docstring)."""
     n = max(DERIVATIVE_DEGREE + 2, int(round(DERIVATIVE_WINDOW / dt)) | 1)
-    return np.stack([savgol_coeffs(n, DERIVATIVE_DEGREE, deriv=d, delta=dt, pos=n - 1, use="dot") for d in (1, 2)])
+    return savgol_coeffs(n, DERIVATIVE_DEGREE, deriv=2, delta=dt, pos=n - 1, use="dot")[None, :]
+
+
+def turn_rate_rows(rot: Sequence[float], rates: Sequence[float], slow_yaw_rate: float) -> list[float]:
+    """The nine entries, row by row, of Ṙ = R [ω]× − ψ̇_s [ẑ]× R [1/s] (module docstring):
+    the rate of the wave-frequency turn R (``rot``, row by row) of a body turning at ``rates``
+    ω (3,) [rad/s, body] whose slow yaw turns at ``slow_yaw_rate`` ψ̇_s [rad/s], which R
+    leaves out."""
+    r0, r1, r2, r3, r4, r5, r6, r7, r8 = rot
+    wx, wy, wz = rates
+    s = slow_yaw_rate
+    return [r1 * wz - r2 * wy + s * r3, r2 * wx - r0 * wz + s * r4, r0 * wy - r1 * wx + s * r5,
+            r4 * wz - r5 * wy - s * r0, r5 * wx - r3 * wz - s * r1, r3 * wy - r4 * wx - s * r2,
+            r7 * wz - r8 * wy, r8 * wx - r6 * wz, r6 * wy - r7 * wx]

@@ -30,8 +30,8 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    filters' real-time outputs (paper 003's observer per axis). The delayed outputs are the
    axis filters' either way.
 4. **Monitoring points**: each adds its lever arm's motion about its mean, R r − ⟨R r⟩ with
-   R = Rz(ψ_w) Ry(θ) Rx(φ), and its rate and acceleration (:mod:`.level_frame`), the exact
-   rigid-body transfer (paper 003 eqs. 10-11 generalised to three axes and a 3-D lever arm).
+   R = Rz(ψ_w) Ry(θ) Rx(φ), its rate Ṙ r from the gyro (Ṙ = R [ω]× less the slow yaw's turn)
+   and its acceleration (:mod:`.level_frame`), the exact rigid-body transfer (paper 003 eqs. 10-11 generalised to three axes and a 3-D lever arm).
    ψ_w, the yaw's wave-frequency part, comes from a fourth Wiener filter, on the Euler yaw
    rate ψ̇ (its "rate" output: the filter estimates ż from z̈ = ψ̇ with z = ∫ψ), designed like
    the others from ψ̇'s spectrum with the gyro's noise and bias as the sensor's
@@ -49,9 +49,9 @@ What runs when: every step, the attitude, the level frame's rows and a_h on Pyth
 (:func:`~.level_frame.level_rows`), the joint filter's ring write and, once fitted, its one
 gather and product, each filter's ring writes and the four filters' outputs
 as one batched product (:class:`~marinefmu.estimators.heave.wiener.WienerGroup`), and the
-points' arms: the nine entries of R − I and their slow mean on floats, one (2 × W)·(W × 9)
-product on a contiguous slice of their ring (stored twice for it) for the rates and
-accelerations, and one (4 × 12)·(12 × 3(P + 1)) product from them and the IMU's motion to every
+points' arms: the nine entries of R − I and their slow mean on floats, those of Ṙ from the
+gyro, one (1 × W)·(W × 9) product on a contiguous slice of their ring (stored twice for it) for
+the accelerations, and one (4 × 12)·(12 × 3(P + 1)) product from them and the IMU's motion to every
 location's (:func:`~.level_frame.location_map`); before every filter has a design, shared
 read-only zeros;
 every second, the heave filter's bias-step search;
@@ -82,7 +82,7 @@ from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW
 from .joint import JointMotion, linear_channels
-from .level_frame import SlowLowPass, derivative_weights, level_rows, location_map, unwrap
+from .level_frame import SlowLowPass, acceleration_weights, level_rows, location_map, turn_rate_rows, unwrap
 from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
@@ -114,11 +114,10 @@ def zero_outputs(rows: int) -> tuple[np.ndarray, np.ndarray]:
     return zeros, zero_acc
 
 
-def euler_yaw_rate(gyro: Any, att: AttitudeResult) -> float:
-    """ψ̇ = (sin φ ω_y + cos φ ω_z) / cos θ [rad/s] from the body rate less the estimated bias."""
-    w_y = float(gyro[1]) - float(att.gyro_bias[1])
-    w_z = float(gyro[2]) - float(att.gyro_bias[2])
-    return (math.sin(att.roll) * w_y + math.cos(att.roll) * w_z) / math.cos(att.pitch)
+def euler_yaw_rate(rates: tuple[float, float, float], att: AttitudeResult) -> float:
+    """ψ̇ = (sin φ ω_y + cos φ ω_z) / cos θ [rad/s] from the body rate less the estimated bias
+    ``rates`` [rad/s]."""
+    return (math.sin(att.roll) * rates[1] + math.cos(att.roll) * rates[2]) / math.cos(att.pitch)
 
 
 class MotionReferenceUnit:
@@ -177,7 +176,7 @@ class MotionReferenceUnit:
         for i, axis in enumerate(filters):            # heave, yaw, surge, sway a quarter interval apart
             axis.start(dt, m.window + m.peak_interval * (2, 3, 0, 1)[i] / 4.0,
                        interval=DESIGN_ROUNDS * m.peak_interval)
-        self.weights = derivative_weights(dt)
+        self.weights = acceleration_weights(dt)
         self.lag_steps = self.axes[0].lag_steps
         self.group.bind()
         ring = max(self.lag_steps + 1, self.weights.shape[1])
@@ -233,21 +232,25 @@ class MotionReferenceUnit:
         points = len(self.arms)
         values: list[float | None]
         if good:
-            self.yaw = att.yaw if self.yaw is None else unwrap(self.yaw, att.yaw)
-            self.psi_bar = self.yaw_ref.push_one(self.yaw, dt)
+            first = self.yaw is None
+            self.yaw = att.yaw if first else unwrap(self.yaw, att.yaw)
+            psi_bar = self.yaw_ref.push_one(self.yaw, dt)
+            slow_yaw_rate = 0.0 if first else (psi_bar - self.psi_bar) / dt
+            self.psi_bar = psi_bar
             r = self.rot_rows = level_rows(self.psi_bar, att.q)
             f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
             heave_acc = r[6] * f0 + r[7] * f1 + r[8] * f2 + G
             values = [r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2, heave_acc]
-            if self.joint is not None:
+            if self.joint is not None or points:
                 b = att.gyro_bias
                 rates = (float(gyro[0]) - float(b[0]), float(gyro[1]) - float(b[1]), float(gyro[2]) - float(b[2]))
+            if self.joint is not None:
                 channels = linear_channels(rates, att.roll, att.pitch, values)
                 self.joint.push(channels)
                 if points:                             # the yaw filter serves the lever arms only
                     values.append(channels[2])
             elif points:
-                values.append(euler_yaw_rate(gyro, att))
+                values.append(euler_yaw_rate(rates, att))
         else:
             heave_acc = None
             values = [None] * (4 if points else 3)
@@ -266,10 +269,12 @@ class MotionReferenceUnit:
                 rot = self.rot_rows if yaw_wave is None else rot_nb_rows(att.roll, att.pitch, yaw_wave)
                 turn = [v - e for v, e in zip(rot, IDENTITY_ROWS)]              # R_hb − I
                 ring[i::n] = [t - m for t, m in zip(turn, self.turn_mean.push(turn, dt))]
+                self.terms[1, :9] = turn_rate_rows(rot, rates, slow_yaw_rate)   # Ṙ, the slow yaw ψ̄'s rate left out
             elif self.k == 0:
                 ring[i::n] = 0.0
             else:
                 ring[i::n] = ring[(self.k - 1) % n]
+                self.terms[1, :9] = 0.0                # the arms held: no turn rate
         self.k += 1
         heave_axis = self.axes[2]
         if heave_acc is not None:
@@ -311,10 +316,10 @@ class MotionReferenceUnit:
         j = (self.k - 1) % n                   # the newest sample's row
         terms = self.terms
         terms[0, :9] = ring[j]
-        if self.k >= w:                        # the rate and acceleration rows; oldest sample first
-            np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[1::2, :9])
+        if self.k >= w:                        # the acceleration row; oldest sample first
+            np.matmul(self.weights, ring[j + n - w + 1:j + n + 1], out=terms[3:, :9])
         else:
-            terms[1::2, :9] = 0.0
+            terms[3, :9] = 0.0
         terms[2, :9] = ring[(self.k - 1 - self.lag_steps) % n]
         terms[:3, 9:] = out[:3, :3].T
         if now is not None:
