@@ -298,6 +298,22 @@ def test_the_joint_filter_meets_the_goals_at_the_imu_where_the_axis_filters_miss
     assert np.all(rt_axis[:2] > 1.5 * np.maximum(2.0, goal[:2] * std[:2])), rt_axis
 
 
+def test_without_the_aid_reference_the_attitude_is_the_axis_units(high_sea):
+    """``aid_reference = False``: the joint filter still gives the real-time motion, but the
+    attitude never takes its reference, so roll and pitch are those of the unit without a joint
+    filter to the last bit; with it (the default) they differ once the joint filter has taken
+    over."""
+    rec, joint, axis = high_sea
+    unreferenced = run_mru(rec, MotionReferenceUnitParams(aid_reference=False))
+    np.testing.assert_array_equal(unreferenced["roll"], axis["roll"])
+    np.testing.assert_array_equal(unreferenced["pitch"], axis["pitch"])
+    k0 = int(np.argmax(unreferenced["joint"]))
+    assert k0 > 0 and unreferenced["joint"][k0:].all()
+    assert np.any(joint["roll"][k0:] != axis["roll"][k0:])
+    with pytest.raises(ParameterError, match="aid_reference"):
+        MotionReferenceUnitParams(aid_reference="yes")
+
+
 def test_a_state_restored_while_the_joint_filter_runs_continues_bit_identically(high_sea):
     """Saved at 1000 s (the joint filter fitted, blended and the attitude's aid reference set),
     through JSON, and restored into a new unit: the next 20 s are the same to the last bit."""

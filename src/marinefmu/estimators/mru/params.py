@@ -68,6 +68,14 @@ class MotionReferenceUnitParams:
         ``"axis"``, the axis filters alone (paper 003's observer per axis). [``motion_model``]
     joint_memory : float
         Span of the joint filter's rows [s], [10, 300] (:data:`JOINT_MEMORY`). [``joint_memory``]
+    aid_reference : bool
+        Once the joint filter has taken over, its horizontal motion at the IMU is the reference
+        of the attitude's aid (default): roll and pitch err 2-3 × less in waves. Its error then
+        follows the joint filter's, so that at a far point the heave error of the IMU and that
+        of the lever arm add rather than cancel: a heave compensator, which passes every
+        in-band error of the tip's heave to its load, may do better without it
+        (``docs/decisions/mru-design.md``). Only with ``motion_model = "joint"``.
+        [``aid_reference``]
     """
 
     attitude: AttitudeEstimatorParams = field(default_factory=AttitudeEstimatorParams)
@@ -76,6 +84,7 @@ class MotionReferenceUnitParams:
     heading_tau: float = HEADING_TAU
     motion_model: str = "joint"
     joint_memory: float = JOINT_MEMORY
+    aid_reference: bool = True
 
     def __post_init__(self) -> None:
         if self.motion.model != "wiener":
@@ -96,6 +105,8 @@ class MotionReferenceUnitParams:
         check_range("heading_tau", self.heading_tau, lo=1.0, hi=3600.0, unit="s")
         check_choice("motion_model", self.motion_model, MOTION_MODELS)
         check_range("joint_memory", self.joint_memory, lo=10.0, hi=300.0, unit="s")
+        if not isinstance(self.aid_reference, (bool, np.bool_)):
+            raise ParameterError(f"aid_reference must be true or false, got {self.aid_reference!r}")
 
 
 @dataclass(slots=True)

@@ -301,7 +301,7 @@ class MotionReferenceUnit:
                     share = joint.share()
                     if share < 1.0:                # moving over from the axis filters' outputs
                         now = share * now + (1.0 - share) * out[:3, :2].T
-                if joint.blended and good and joint.clean():
+                if joint.blended and good and self.params.aid_reference and joint.clean():
                     reference = self._aid_reference(now)
             self.attitude.aid_reference = reference
         if not points:                             # the IMU's row only: views of this step's own outputs
