@@ -75,3 +75,26 @@ def test_the_reference_is_part_of_the_state():
     copy = AttitudeEstimator(params)
     copy.set_state(json.loads(json.dumps(est.get_state())))
     assert copy.aid_reference == est.aid_reference and copy._referenced
+
+
+def test_aid_due_says_which_steps_read_the_reference(waves):
+    """``aid_due(dt)`` before a step is true exactly on the steps that make an aid update (10 Hz
+    at the defaults, every tenth 100 Hz step once levelled): a reference that changes every
+    step but is read only then gives the same angles as one set only on those steps."""
+    gyro, acc = stack(waves, "imu.gyro"), stack(waves, "imu.acc")
+    every, gated = AttitudeEstimator(), AttitudeEstimator()
+    due_steps, aid_steps = [], []
+    for k in range(int(150.0 / DT)):
+        ref = (0.01 * math.sin(0.3 * k * DT), 0.0, 0.0, 0.003 * math.cos(0.3 * k * DT))
+        every.aid_reference = ref
+        if gated.aid_due(DT):
+            gated.aid_reference = ref
+            due_steps.append(k)
+        levelling = gated.levelling
+        a, b = every.step(gyro[k], acc[k], DT), gated.step(gyro[k], acc[k], DT)
+        if not levelling and gated.since_aid == 0.0:       # an update resets the count
+            aid_steps.append(k)
+        assert (a.roll, a.pitch) == (b.roll, b.pitch), k
+    levelled = aid_steps[0]
+    assert [k for k in due_steps if k >= levelled] == aid_steps
+    assert np.all(np.diff(aid_steps) == 10)

@@ -468,6 +468,11 @@ class AttitudeEstimator:
             self._aid(ax, ay, az, dt)
         return self._result(warning is None, warning)
 
+    def aid_due(self, dt: float) -> bool:
+        """Whether the next step, of ``dt`` s, makes an aid update (the one step that reads
+        :attr:`aid_reference`): a caller that sets the reference need compute it only then."""
+        return self.since_aid + dt >= self._aid_period
+
     def _level(self, wx: float, wy: float, wz: float, ax: float, ay: float, az: float, dt: float) -> None:
         """Accumulate the specific force in the frame of the first sample (gyro-derotated)."""
         if self.level_steps > 0:

@@ -185,6 +185,13 @@ class JointMotion:
         self.ring[self.k % self.n] = t
         self.k += 1
 
+    def step(self, channels: tuple[float, ...] | None, outputs: np.ndarray, valid: bool) -> np.ndarray | None:
+        """:meth:`push`, :meth:`teach` and, once fitted, :meth:`predict` in one call (the
+        unit's every step once its axis filters give outputs)."""
+        self.push(channels)
+        self.teach(outputs, valid)
+        return None if self.weights is None else self.predict()
+
     def gather(self, age: int = 0) -> np.ndarray:
         """(B + 1, 9) running sums at the block edges of the row ``age`` samples before the
         newest, newest edge first."""

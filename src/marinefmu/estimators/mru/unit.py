@@ -231,6 +231,7 @@ class MotionReferenceUnit:
         good = att.valid and att.warning is None
         points = len(self.arms)
         values: list[float | None]
+        channels = None                                # the joint filter's sample (None: a bad one)
         if good:
             first = self.yaw is None
             self.yaw = att.yaw if first else unwrap(self.yaw, att.yaw)
@@ -246,7 +247,6 @@ class MotionReferenceUnit:
                 rates = (float(gyro[0]) - float(b[0]), float(gyro[1]) - float(b[1]), float(gyro[2]) - float(b[2]))
             if self.joint is not None:
                 channels = linear_channels(rates, att.roll, att.pitch, values)
-                self.joint.push(channels)
                 if points:                             # the yaw filter serves the lever arms only
                     values.append(channels[2])
             elif points:
@@ -254,8 +254,6 @@ class MotionReferenceUnit:
         else:
             heave_acc = None
             values = [None] * (4 if points else 3)
-            if self.joint is not None:
-                self.joint.push(None)
         out = self.group.push(values)                  # (axes, 4): position, rate, delayed position, rate
         ring = self.turn_ring
         n = len(ring) // 2
@@ -286,6 +284,8 @@ class MotionReferenceUnit:
         warning = restart or att.warning or heading_warning
         angles_valid = att.valid and heading_warning is None
         if out is None:
+            if self.joint is not None:
+                self.joint.push(channels)
             zeros, zero_acc = self.no_motion
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros, zero_acc, zeros, self.delay_s,
                              heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
@@ -293,17 +293,15 @@ class MotionReferenceUnit:
         joint = self.joint
         now = None                                 # the joint filter's (2, 3) position and rate, once taught
         if joint is not None:
-            joint.teach(out, delayed_valid)
-            reference = None
-            if joint.ready:
-                now = joint.predict()
+            now = joint.step(channels, out, delayed_valid)
+            if now is not None:
                 if not joint.blended:
                     share = joint.share()
                     if share < 1.0:                # moving over from the axis filters' outputs
                         now = share * now + (1.0 - share) * out[:3, :2].T
-                if joint.blended and good and self.params.aid_reference and joint.clean():
-                    reference = self._aid_reference(now)
-            self.attitude.aid_reference = reference
+                if joint.blended and self.params.aid_reference and self.attitude.aid_due(dt):
+                    # the attitude reads it at its next aid only
+                    self.attitude.aid_reference = self._aid_reference(now) if good and joint.clean() else None
         if not points:                             # the IMU's row only: views of this step's own outputs
             if now is None:
                 position, velocity = out[None, :3, 0], out[None, :3, 1]
