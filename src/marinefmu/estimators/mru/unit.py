@@ -6,9 +6,10 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    tilt correction; :mod:`marinefmu.estimators.attitude.estimator`) gives R_nb, roll, pitch and
    the gyro-integrated yaw ψ. Once the joint filter (step 3) has taken over, and while its
    rows hold no bad sample, its horizontal position and velocity at the IMU are the
-   attitude's aid reference (the estimator's "aid reference"): the aid then tells the tilt's
-   slow drift from the waves to centimetres rather than metres per second, and roll and pitch
-   err 2-3 × less in waves.
+   attitude's aid reference (the estimator's "aid reference"; ``aid_reference``, on by
+   default): the aid then tells the tilt's slow drift from the waves to centimetres rather than
+   metres per second, and roll and pitch err 2-3 × less in waves. It is computed only on the
+   steps before the attitude's aid updates (``AttitudeEstimator.aid_due``), which alone read it.
 2. **Level frame** (:mod:`.level_frame`): R_hb = Rz(−ψ̄) R_nb, with ψ̄ the slow part of ψ, and
    the IMU's acceleration there, a_h = R_hb f_b + [0, 0, g] (the horizontal specific force after
    tilt compensation).
