@@ -236,9 +236,8 @@ class MotionReferenceUnit:
         if good:
             first = self.yaw is None
             self.yaw = att.yaw if first else unwrap(self.yaw, att.yaw)
-            psi_bar = self.yaw_ref.push_one(self.yaw, dt)
-            slow_yaw_rate = 0.0 if first else (psi_bar - self.psi_bar) / dt
-            self.psi_bar = psi_bar
+            previous_psi_bar = self.psi_bar
+            self.psi_bar = self.yaw_ref.push_one(self.yaw, dt)
             r = self.rot_rows = level_rows(self.psi_bar, att.q)
             f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
             heave_acc = r[6] * f0 + r[7] * f1 + r[8] * f2 + G
@@ -268,6 +267,7 @@ class MotionReferenceUnit:
                 rot = self.rot_rows if yaw_wave is None else rot_nb_rows(att.roll, att.pitch, yaw_wave)
                 turn = [v - e for v, e in zip(rot, IDENTITY_ROWS)]              # R_hb − I
                 ring[i::n] = [t - m for t, m in zip(turn, self.turn_mean.push(turn, dt))]
+                slow_yaw_rate = 0.0 if first else (self.psi_bar - previous_psi_bar) / dt
                 self.terms[1, :9] = turn_rate_rows(rot, rates, slow_yaw_rate)   # Ṙ, the slow yaw ψ̄'s rate left out
             elif self.k == 0:
                 ring[i::n] = 0.0
