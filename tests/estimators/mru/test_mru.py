@@ -35,7 +35,7 @@ def errors_cm(rec, out, row, arm, k0=15000):
 
 def test_real_time_and_delayed_motion_at_the_imu_meet_the_goals(polar):
     """At the IMU (surge / sway / heave std 25 / 33 / 56 cm): real-time heave within the goal
-    max(2 cm, 2.5 %), surge and sway within 2.5 and 4.5 cm (measured 2.27 / 4.04 cm on this
+    max(2 cm, 2.5 %), surge and sway within 2.5 and 4.5 cm (measured 2.29 / 3.72 cm on this
     record from 150 s; the goal max(2 cm, 5 %) is 2 cm: the attitude's tilt error, g·ε in the
     horizontal acceleration, is most of the gap), and the delayed outputs below half the
     real-time error on every axis."""
@@ -272,6 +272,44 @@ def test_the_scalar_low_pass_and_the_location_map_repeat_the_general_ones():
     np.testing.assert_allclose(at, np.vstack([imu, imu + arms @ rot.T - arms]), rtol=0, atol=1e-13)
 
 
+def test_the_gyros_tilt_is_the_complementary_filter_and_keeps_the_gyros_wave_band():
+    """``GyroTilt`` is c_k = (1 − α)(c_{k−1} + Δt (u_{k−1} + u_k)/2) + α a_k (scipy's
+    ``lfilter``, through a state save). On a roll of a 10 s wave plus a slow list, with the
+    attitude's angle carrying a 10 s error of 0.01° and a 0.5° step at 100 s, and the gyro's rate
+    exact, a − c is the high-pass of the attitude's error: the step decaying as e^{−t/τ} and
+    the wave-band error to within 2 % of its amplitude (measured 1.4 %: the first-order
+    crossover's phase at 10 s, 1/(ωτ) = 1.6 %), and nothing of the motion itself."""
+    from scipy.signal import lfilter
+
+    from marinefmu.estimators.mru.level_frame import GyroTilt
+
+    dt, tau = 0.01, 100.0
+    t = np.arange(0.0, 1000.0, dt)
+    w = 2.0 * math.pi / 10.0
+    true = np.radians(3.0) * np.sin(w * t) + np.radians(1.0) * np.sin(2.0 * math.pi * t / 600.0)
+    rate = np.gradient(true, dt)
+    wave_error = np.radians(0.01) * np.sin(w * t + 0.7)
+    step = np.radians(0.5) * (t >= 100.0)
+    measured = true + wave_error + step
+    tilt = GyroTilt(tau)
+    out = []
+    for k in range(len(t)):
+        out.append(tilt.push(rate[k], -rate[k], measured[k], -measured[k], dt))
+        if k == 4000:
+            restored = GyroTilt(tau)
+            restored.set_state(json.loads(json.dumps(tilt.get_state())))
+            tilt = restored
+    out = np.array(out)
+    alpha = 1.0 - math.exp(-dt / tau)
+    c = lfilter([1.0], [1.0, alpha - 1.0], (1.0 - alpha) * dt * (rate[:-1] + rate[1:]) / 2 + alpha * measured[1:],
+                zi=[(1.0 - alpha) * measured[0]])[0]
+    np.testing.assert_allclose(out[1:, 0], measured[1:] - c, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(out[:, 1], -out[:, 0], rtol=0, atol=1e-15)
+    settled = t >= 900.0
+    step_left = step[settled] * np.exp(-(t[settled] - 100.0) / tau)
+    assert np.max(np.abs(out[settled, 0] - wave_error[settled] - step_left)) <= 0.02 * np.radians(0.01)
+
+
 @pytest.fixture(scope="module")
 def high_sea():
     """polar_supply in Hs 6 m / Tp 14 s, IMU at the COG, 1200 s: the joint filter's first fit
@@ -283,8 +321,8 @@ def high_sea():
 def test_the_joint_filter_meets_the_goals_at_the_imu_where_the_axis_filters_miss(high_sea):
     """Once taught (``joint``, from 840 s), the real-time surge, sway and heave at the IMU are
     within max(2 cm, 5 %) and max(2 cm, 2.5 %) of the truth's std (std 83 / 91 / 151 cm, goals
-    4.1 / 4.5 / 3.8 cm; measured 3.7 / 3.4 / 2.5 cm); the axis filters alone, over the same
-    samples, miss surge and sway by more than half again (6.8 / 8.9 cm: the attitude's tilt error,
+    4.1 / 4.5 / 3.8 cm; measured 2.2 / 2.4 / 2.5 cm); the axis filters alone, over the same
+    samples, miss surge and sway by more than a third (5.7 / 7.6 cm: the attitude's tilt error,
     module docstring of ``marinefmu.estimators.mru.joint``). Before the fit the unit's outputs
     are the axis filters' own."""
     rec, joint, axis = high_sea
@@ -295,7 +333,26 @@ def test_the_joint_filter_meets_the_goals_at_the_imu_where_the_axis_filters_miss
     rt, _, std = errors_cm(rec, joint, 0, (0.0, 0.0, 0.0), k0)
     rt_axis, _, _ = errors_cm(rec, axis, 0, (0.0, 0.0, 0.0), k0)
     assert np.all(rt <= np.maximum(2.0, goal * std)), (rt, std)
-    assert np.all(rt_axis[:2] > 1.5 * np.maximum(2.0, goal[:2] * std[:2])), rt_axis
+    assert np.all(rt_axis[:2] > 1.3 * np.maximum(2.0, goal[:2] * std[:2])), rt_axis
+
+
+def test_the_gyros_tilt_takes_the_attitudes_in_band_error_out_of_surge_and_sway(high_sea):
+    """``tilt_tau`` (the horizontal axes' tilt from the integrated gyro in the wave band,
+    ``GyroTilt``) against ``tilt_tau = 0`` (the attitude's own tilt), from the joint filter's
+    takeover: the real-time surge and sway at the IMU err at most 0.75 × as much (measured 0.59 /
+    0.70: 2.19 / 2.35 cm against 3.71 / 3.37), the delayed at most 0.6 × (measured 0.49 / 0.33),
+    and heave, which the tilt does not enter, within 5 % (2.46 against 2.49 cm: the joint
+    filter's heave rows see the attitude through its aid reference)."""
+    rec, joint, _ = high_sea
+    attitude_tilt = run_mru(rec, MotionReferenceUnitParams(tilt_tau=0.0))
+    k0 = int(np.argmax(joint["joint"]))
+    rt, delayed, _ = errors_cm(rec, joint, 0, (0.0, 0.0, 0.0), k0)
+    rt_0, delayed_0, _ = errors_cm(rec, attitude_tilt, 0, (0.0, 0.0, 0.0), k0)
+    assert np.all(rt[:2] <= 0.75 * rt_0[:2]), (rt, rt_0)
+    assert np.all(delayed[:2] <= 0.6 * delayed_0[:2]), (delayed, delayed_0)
+    assert abs(rt[2] - rt_0[2]) <= 0.05 * rt_0[2]
+    with pytest.raises(ParameterError, match="tilt_tau"):
+        MotionReferenceUnitParams(tilt_tau=-1.0)
 
 
 def test_without_the_aid_reference_the_attitude_is_the_axis_units(high_sea):

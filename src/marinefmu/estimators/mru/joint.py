@@ -277,10 +277,12 @@ class JointMotion:
 
     def predict(self) -> np.ndarray:
         """(2, 3) position [m] and rate [m/s] of surge, sway, heave now (after :meth:`push`), a
-        new array: one gather of the running sums at the edges into a kept buffer, one product."""
-        np.add(self.ages, self.k - 1, out=self.index)
-        np.take(self.ring, self.index, axis=0, out=self.nodes, mode="wrap")
-        return np.dot(self.node_weights, self.flat_nodes).reshape(2, 3)
+        new array: one gather of the running sums at the edges into a kept buffer, one product
+        (the arrays' own methods: numpy's module functions add about 0.7 µs of dispatch here)."""
+        index = self.index
+        np.add(self.ages, self.k - 1, index)
+        self.ring.take(index, 0, self.nodes, "wrap")
+        return self.node_weights.dot(self.flat_nodes).reshape(2, 3)
 
     def get_state(self) -> dict:
         """JSON-serialisable state."""

@@ -33,6 +33,10 @@ MOTION_MODELS = ("joint", "axis")
 #: Default span of the joint filter's rows [s]: the sea's response at the peak period and the
 #: attitude's coupling over several wave groups; 120 s moves the benchmark's errors by under 10 %.
 JOINT_MEMORY = 60.0
+#: Crossover of the horizontal axes' tilt between the attitude and the integrated gyro [s]
+#: (:class:`~.level_frame.GyroTilt`): far below the wave band (a 5-20 s sea), so that the
+#: wave-frequency tilt is the gyro's, and short beside the gyro bias's wander.
+TILT_TAU = 100.0
 
 
 def default_motion() -> HeaveObserverParams:
@@ -76,6 +80,10 @@ class MotionReferenceUnitParams:
         in-band error of the tip's heave to its load, may do better without it
         (``docs/decisions/mru-design.md``). Only with ``motion_model = "joint"``.
         [``aid_reference``]
+    tilt_tau : float
+        The horizontal axes' acceleration is turned with a tilt that follows the attitude below
+        1/τ and the integrated gyro above it (:class:`~.level_frame.GyroTilt`), [0, 3600] s
+        (:data:`TILT_TAU`); 0 turns it with the attitude's own tilt. [``tilt_tau``]
     """
 
     attitude: AttitudeEstimatorParams = field(default_factory=AttitudeEstimatorParams)
@@ -85,6 +93,7 @@ class MotionReferenceUnitParams:
     motion_model: str = "joint"
     joint_memory: float = JOINT_MEMORY
     aid_reference: bool = True
+    tilt_tau: float = TILT_TAU
 
     def __post_init__(self) -> None:
         if self.motion.model != "wiener":
@@ -105,6 +114,7 @@ class MotionReferenceUnitParams:
         check_range("heading_tau", self.heading_tau, lo=1.0, hi=3600.0, unit="s")
         check_choice("motion_model", self.motion_model, MOTION_MODELS)
         check_range("joint_memory", self.joint_memory, lo=10.0, hi=300.0, unit="s")
+        check_range("tilt_tau", self.tilt_tau, lo=0.0, hi=3600.0, unit="s")
         if not isinstance(self.aid_reference, (bool, np.bool_)):
             raise ParameterError(f"aid_reference must be true or false, got {self.aid_reference!r}")
 

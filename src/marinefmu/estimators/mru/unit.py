@@ -12,7 +12,10 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    steps before the attitude's aid updates (``AttitudeEstimator.aid_due``), which alone read it.
 2. **Level frame** (:mod:`.level_frame`): R_hb = Rz(−ψ̄) R_nb, with ψ̄ the slow part of ψ, and
    the IMU's acceleration there, a_h = R_hb f_b + [0, 0, g] (the horizontal specific force after
-   tilt compensation).
+   tilt compensation). The horizontal axes take it turned by a tilt whose wave-frequency part
+   is the integrated gyro's (:class:`~.level_frame.GyroTilt`, ``tilt_tau``): a_x + g (θ − θ_c),
+   a_y − g (φ − φ_c), with (φ_c, θ_c) the complementary filter's angles; the attitude's aid
+   carries its error into the wave band, the gyro only its noise.
 3. **Three axes**: surge, sway and heave of the IMU, each by paper 003's observer generalised
    from the vertical: the causal Wiener filter designed from that axis's own measured spectrum
    (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`, the HeaveObserver's default
@@ -83,7 +86,7 @@ from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW
 from .joint import JointMotion, linear_channels
-from .level_frame import SlowLowPass, acceleration_weights, level_rows, location_map, turn_rate_rows, unwrap
+from .level_frame import GyroTilt, SlowLowPass, acceleration_weights, level_rows, location_map, turn_rate_rows, unwrap
 from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
@@ -168,6 +171,7 @@ class MotionReferenceUnit:
         self.no_motion = zero_outputs(len(self.arms) + 1)
         self.joint: JointMotion | None = None
         self.psi_bar = 0.0                            # ψ̄, the level frame's reference yaw [rad]
+        self.gyro_tilt = GyroTilt(p.tilt_tau) if p.tilt_tau > 0.0 else None
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -242,13 +246,20 @@ class MotionReferenceUnit:
             f0, f1, f2 = float(acc[0]), float(acc[1]), float(acc[2])
             heave_acc = r[6] * f0 + r[7] * f1 + r[8] * f2 + G
             values = [r[0] * f0 + r[1] * f1 + r[2] * f2, r[3] * f0 + r[4] * f1 + r[5] * f2, heave_acc]
-            if self.joint is not None or points:
+            tilt = self.gyro_tilt
+            if self.joint is not None or points or tilt is not None:
                 b = att.gyro_bias
                 rates = (float(gyro[0]) - float(b[0]), float(gyro[1]) - float(b[1]), float(gyro[2]) - float(b[2]))
-            if self.joint is not None:
-                channels = linear_channels(rates, att.roll, att.pitch, values)
+            if self.joint is not None or tilt is not None:
+                euler = linear_channels(rates, att.roll, att.pitch, values)
+                if self.joint is not None:
+                    channels = euler
                 if points:                             # the yaw filter serves the lever arms only
-                    values.append(channels[2])
+                    values.append(euler[2])
+                if tilt is not None:                   # the horizontal axes' tilt: the gyro's in the wave band
+                    d_roll, d_pitch = tilt.push(euler[0], euler[1], att.roll, att.pitch, dt)
+                    values[0] += G * d_pitch
+                    values[1] -= G * d_roll
             elif points:
                 values.append(euler_yaw_rate(rates, att))
         else:
@@ -364,7 +375,8 @@ class MotionReferenceUnit:
                 "yaw_ref": self.yaw_ref.get_state(),
                 "turn_mean": self.turn_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
                 "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist(),
-                "joint": None if self.joint is None else self.joint.get_state(), "psi_bar": self.psi_bar}
+                "joint": None if self.joint is None else self.joint.get_state(), "psi_bar": self.psi_bar,
+                "gyro_tilt": None if self.gyro_tilt is None else self.gyro_tilt.get_state()}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -386,3 +398,5 @@ class MotionReferenceUnit:
         if self.joint is not None and s.get("joint") is not None:
             self.joint.set_state(s["joint"])
         self.psi_bar = float(s.get("psi_bar", 0.0))
+        if self.gyro_tilt is not None:
+            self.gyro_tilt.set_state(s.get("gyro_tilt"))
