@@ -61,12 +61,14 @@ position, as :mod:`marinefmu.bench.mru` scores it).
 from __future__ import annotations
 
 import numpy as np
+from scipy.signal import butter, sosfiltfilt
 
 from ..bench.mru import POINTS as MRU_POINTS
 from ..bench.mru import goals, point_truth, rms_about_mean
-from ..errors import check_range
+from ..errors import check_choice, check_range
 from ..frames import G, rot_nb
-from .tilt_bound import SCORED_SEED, TRAIN_SEEDS, BoundSetup, block_rows, channels, fit, record
+from ..sea.motion_model import stack
+from .tilt_bound import SCORED_SEED, TRAIN_SEEDS, BoundSetup, angle_changes, block_rows, channels, fit, record
 
 #: Fitted targets: the IMU's NED position [m] and the ZYX Euler angles [rad].
 TARGETS = ("truth.imu.n", "truth.imu.e", "truth.imu.d", "truth.roll", "truth.pitch", "truth.yaw")
@@ -75,6 +77,11 @@ TARGETS = ("truth.imu.n", "truth.imu.e", "truth.imu.d", "truth.roll", "truth.pit
 POINTS = ((0.0, 0.0, 0.0), MRU_POINTS[-1])
 #: The rows of both fits (module docstring): the tilt bound's, with blocks of at most 2 s.
 SETUP = BoundSetup(longest=2.0)
+#: Crossover of :func:`gyro_tilt` [Hz]: below every benchmark sea (VesselMotion's has no
+#: energy below half the peak frequency, 0.036 Hz at Tp 14 s).
+GYRO_CROSSOVER = 0.01
+#: The tilts :func:`axis_floor` turns the specific force with.
+TILTS = ("true", "gyro")
 
 
 def targets(rec: dict[str, np.ndarray], ends: np.ndarray) -> np.ndarray:
@@ -171,32 +178,67 @@ def causal_motion_bound(hs: float, tp: float, preset: str = "polar_supply", leve
             "features": weights.shape[0], "rows": sum(len(x) for x, _ in pairs), "scored": scored}
 
 
-def level_specific_force(rec: dict[str, np.ndarray]) -> np.ndarray:
+def gyro_tilt(rec: dict[str, np.ndarray], dt: float, crossover: float = GYRO_CROSSOVER) -> np.ndarray:
+    """(N, 2) roll and pitch [rad] that are the truth below ``crossover`` [Hz] and the integrated
+    gyro above it: θ + HP(∫u − θ), u the Euler rates of the measured gyro (turned with the true
+    attitude), HP scipy's zero-phase second-order Butterworth high-pass. Its only error is the
+    gyro's, integrated, above the crossover (its white noise and its bias's wander faster than
+    the crossover): what any attitude smoother fed this gyro keeps in the wave band, where the
+    aid's information on the tilt (the horizontal acceleration, known to ω² times the motion's
+    error) is worth less than the gyro's (``docs/decisions/mru-design.md``). ``dt``: the
+    record's sample interval [s]."""
+    w = stack(rec, "imu.gyro")
+    phi, theta = rec["truth.roll"], rec["truth.pitch"]
+    sf, cf = np.sin(phi), np.cos(phi)
+    p, q, r = w.T
+    rates = np.column_stack([p + (q * sf + r * cf) * np.tan(theta), q * cf - r * sf])
+    truth = np.column_stack([phi, theta])
+    sos = butter(2, crossover, "high", fs=1.0 / dt, output="sos")
+    return truth + sosfiltfilt(sos, angle_changes(rates, dt) - truth, axis=0)
+
+
+def level_specific_force(rec: dict[str, np.ndarray], tilt: str = "true", dt: float | None = None) -> np.ndarray:
     """(N, 3) measured specific force turned into NED by the true attitude, plus gravity,
     R_nb f_m + g_n [m/s²]: what :func:`marinefmu.bench.mru.true_attitude_cm` feeds the unit's
     axis filters (the linearised channel of :func:`~marinefmu.papers.tilt_bound.channels`
-    without its tilt term)."""
-    tilt = np.column_stack([rec["truth.pitch"], -rec["truth.roll"], np.zeros(len(rec["truth.roll"]))])
-    return channels(rec)[:, 3:] - G * tilt + np.array([0.0, 0.0, G])
+    without its tilt term). ``tilt = "gyro"``: the horizontal part turned instead by
+    :func:`gyro_tilt` (first order, as the linearised channel: f + g [θ − θ_c, −(φ − φ_c), 0]),
+    ``dt`` the record's sample interval [s]."""
+    check_choice("tilt", tilt, TILTS)
+    roll, pitch = rec["truth.roll"], rec["truth.pitch"]
+    if tilt == "gyro":
+        roll, pitch = gyro_tilt(rec, dt).T
+    angles = np.column_stack([pitch, -roll, np.zeros(len(roll))])
+    return channels(rec)[:, 3:] - G * angles + np.array([0.0, 0.0, G])
 
 
 def axis_floor(hs: float, tp: float, preset: str = "polar_supply", lever_arm=(0.0, 0.0, 0.0),
                imu: dict | None = None, setup: BoundSetup = SETUP, train: tuple[int, ...] = TRAIN_SEEDS,
-               train_duration: float = 3600.0, duration: float = 1920.0, motions: dict | None = None) -> list[float]:
+               train_duration: float = 3600.0, duration: float = 1920.0, motions: dict | None = None,
+               lag: float = 0.0, tilt: str = "true") -> list[float]:
     """RMS error about the mean [cm] of the IMU's surge, sway and heave, each estimated by the
     best causal linear filter of its own axis of :func:`level_specific_force` alone (the same
-    blocks and records as :func:`causal_motion_bound`, whose arguments these are): the floor of
-    one filter per axis fed the true attitude, which
-    :func:`marinefmu.bench.mru.true_attitude_cm` measures for the unit's filters. It lies above
-    :func:`causal_motion_bound` by what the other channels tell: in a long-crested sea one wave
-    train drives all six motions, so the gyro's angles predict the accelerations."""
+    blocks and records as :func:`causal_motion_bound`, whose arguments these are, ``lag``
+    included: > 0 for the fixed-lag smoother's): the floor of one filter per axis fed the true
+    attitude, which :func:`marinefmu.bench.mru.true_attitude_cm` measures for the unit's
+    filters. It lies above :func:`causal_motion_bound` by what the other channels tell: in a
+    long-crested sea one wave train drives all six motions, so the gyro's angles predict the
+    accelerations.
+
+    ``tilt = "gyro"``: the force turned by :func:`gyro_tilt`, the true tilt below
+    :data:`GYRO_CROSSOVER` and the integrated gyro above it. Its delayed floor is what one
+    smoother per axis can reach with the best attitude this gyro allows in the wave band; the
+    MotionReferenceUnit's delayed surge and sway are such smoothers."""
+    check_range("lag", lag, lo=0.0, hi=setup.memory, hi_open=True, unit="s")
+    check_choice("tilt", tilt, TILTS)
+    back = int(round(lag / setup.dt))
     training, scored = records(hs, tp, preset, lever_arm, imu, setup, train, train_duration, duration, motions)
     edges = setup.edges()
 
     def rows(rec: dict[str, np.ndarray], start: float) -> tuple[list[np.ndarray], np.ndarray]:
         ends = setup.ends(len(rec["truth.roll"]), start)
-        acc = level_specific_force(rec)
-        return [block_rows(acc[:, [i]], edges, ends) for i in range(3)], targets(rec, ends)[:, :3]
+        acc = level_specific_force(rec, tilt, setup.dt)
+        return [block_rows(acc[:, [i]], edges, ends) for i in range(3)], targets(rec, ends - back)[:, :3]
 
     fitted = [rows(rec, 0.0) for rec in training]
     x, y = rows(scored, setup.settle)

@@ -21,9 +21,10 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`, the HeaveObserver's default
    filter; its docstring has steps 1-3), now and ``motion.smoother_lag`` s ago (the delayed
    outputs: the Wiener smoother for that lag). The horizontal axes take the vertical's design
-   parameters; their spectra and filters are their own, and their designs reject the
-   acceleration below ``omega_min`` (the attitude's slow tilt error times g), so they have no
-   bias-step search (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`).
+   parameters but for the sensor's offset noise, which adds the gyro tilt's
+   (:func:`horizontal_params`); their spectra and filters are their own, and their designs
+   reject the acceleration below ``omega_min`` (the attitude's slow tilt error times g), so
+   they have no bias-step search (:class:`~marinefmu.estimators.heave.wiener.WienerAxis`).
    **Joint filter** (``motion_model = "joint"``, the default; :mod:`.joint`): once it has two
    taught rows per weight (about 14 minutes at the defaults and 100 Hz), the real-time surge,
    sway and heave at the IMU and their rates come instead from one causal linear filter of all
@@ -110,6 +111,28 @@ def yaw_filter_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
                    offset_noise=min(10.0, a.gyro_bias_sigma * math.sqrt(2.0 / a.gyro_bias_tau)))
 
 
+def horizontal_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
+    """The surge and sway filters' parameters: the motion's, with the gyro's error in the
+    offset's random walk when the axes take the gyro's tilt (``tilt_tau`` > 0).
+
+    The tilt's error in the wave band is then the integrated gyro's: g times it is an offset of
+    the horizontal acceleration, which the filters' design takes as noise (the sensor's
+    S_n = N²/π + q²/(πω²), :mod:`~marinefmu.estimators.heave.wiener`) rather than motion. The
+    gyro's white noise N_g [rad/s/√Hz] integrates to a random walk of density g N_g; its bias,
+    a Gauss-Markov process of σ_b and τ_b (the attitude's ``gyro_bias_sigma``,
+    ``gyro_bias_tau``), to an acceleration of density g² 2σ_b²/(τ_b ω⁴) above 1/τ_b, taken as a
+    random walk of the same density at ``omega_min``, where it counts most:
+
+    .. math::
+        q_h^2 = q^2 + g^2 \\left(N_g^2 + \\frac{2σ_b^2}{τ_b\\, ω_{min}^2}\\right).
+    """
+    if params.tilt_tau <= 0.0:
+        return params.motion
+    a, m = params.attitude, params.motion
+    tilt_density = G * math.sqrt(a.gyro_noise**2 + 2.0 * a.gyro_bias_sigma**2 / (a.gyro_bias_tau * m.omega_min**2))
+    return replace(m, offset_noise=math.hypot(m.offset_noise, tilt_density))
+
+
 def zero_outputs(rows: int) -> tuple[np.ndarray, np.ndarray]:
     """Read-only zero (rows, 3) motion and (rows,) heave acceleration: the outputs before every
     filter has a design, shared by every such step (no arrays to build while nothing is known)."""
@@ -153,8 +176,9 @@ class MotionReferenceUnit:
         """Back to the initial state."""
         p = self.params
         self.attitude = AttitudeEstimator(p.attitude)
-        self.axes = [WienerAxis(p.motion, self.log, f"mru {name}", reject_below=name != "heave",
-                                find_steps=name == "heave") for name in AXES]
+        horizontal = horizontal_params(p)
+        self.axes = [WienerAxis(p.motion if name == "heave" else horizontal, self.log, f"mru {name}",
+                                reject_below=name != "heave", find_steps=name == "heave") for name in AXES]
         self.yaw_axis = WienerAxis(yaw_filter_params(p), self.log, "mru yaw", reject_below=True, find_steps=False)
         self.group = WienerGroup([*self.axes, self.yaw_axis] if len(self.arms) else self.axes)
         self.yaw_ref = SlowLowPass(YAW_TAU)
