@@ -73,3 +73,11 @@ def test_the_taught_joint_filter_runs_in_the_fmu_as_in_process(fmu_dir, tmp_path
         joint_steps += r.joint
     assert joint_steps >= 1000
     f.close()
+
+
+def test_the_fmu_parameters_reach_the_unit():
+    """``mru_params`` passes the FMU's own names to the unit's parameters (the FMU test above
+    builds both sides from it, so a parameter it dropped would go unseen there)."""
+    p = mru_params({"tilt_tau": 0.0, "aid_reference": False, "joint_memory": 90.0, "motion_model": "axis"})
+    assert (p.tilt_tau, p.aid_reference, p.joint_memory, p.motion_model) == (0.0, False, 90.0, "axis")
+    assert mru_params({"tilt_tau": 50.0}).tilt_tau == 50.0

@@ -76,10 +76,12 @@ def run_mru(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams) -> di
 
 
 def true_attitude_cm(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams, k0: int) -> list[float]:
-    """Real-time RMS error [cm] of surge, sway, heave at the IMU from ``k0`` of the unit's three
-    axis filters fed the measured specific force turned into the level frame by the *true*
-    attitude: what the filters do when the attitude is exact, so that the rest of the unit's
-    error is the AttitudeEstimator's."""
+    """Real-time RMS error [cm] of surge, sway, heave at the IMU from ``k0`` of three axis
+    filters at the unit's motion parameters, designed for the accelerometer's noise alone (the
+    noise an exact attitude leaves; the unit's surge and sway add the gyro tilt's), fed the
+    measured specific force turned into the level frame by the *true* attitude: what the
+    filters do when the attitude is exact, so that the rest of the unit's error is the
+    AttitudeEstimator's."""
     from ..estimators.heave.common import SilentLog
     from ..estimators.heave.wiener import WienerAxis
     from ..frames import G
@@ -301,8 +303,8 @@ def print_heave_and_angles(rows: list[dict]) -> None:
 
 
 def mru_bench(progress: bool = True) -> dict:
-    """Every case of :data:`~.defaults.CASES`, two at a time (about 10 minutes on a 2-core
-    machine), printed as a table, and the cost per step against its budget (the
+    """Every case of :data:`~.defaults.CASES`, two at a time (about 12 minutes on a 2-core
+    machine, the causal bounds included), printed as a table, and the cost per step against its budget (the
     AttitudeEstimator's plus 1.5 × the HeaveObserver's)."""
     from concurrent.futures import ProcessPoolExecutor
 

@@ -334,7 +334,7 @@ MRU_PARAMETERS: list[Variable] = [
     Variable("aid_reference", "boolean", _MRU.aid_reference, "", "The joint filter's horizontal motion is the "
              "attitude's aid reference once it has taken over (roll and pitch err 2-3 x less in waves)"),
     real("tilt_tau", _MRU.tilt_tau, "s", "The horizontal axes' tilt follows the attitude below 1/tilt_tau and the "
-         "integrated gyro above it; 0: the attitude's own tilt, [0, 3600]"),
+         "integrated gyro above it; 0: the attitude's own tilt, else [10, 3600]"),
     Variable("aid_sizing", "string", _MRU.attitude.aid_sizing, "", f"Attitude aiding size: one of {', '.join(AID_SIZINGS)} (as the AttitudeEstimator's)"),
     real("vel_sigma", _MRU.attitude.vel_sigma, "m/s", "Attitude zero-velocity pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 100]"),
     real("pos_sigma", _MRU.attitude.pos_sigma, "m", "Attitude zero-position pseudo-measurement standard deviation (aid_sizing = fixed; the start of auto), (0, 1000]"),

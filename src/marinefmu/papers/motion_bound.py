@@ -65,7 +65,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from ..bench.mru import POINTS as MRU_POINTS
 from ..bench.mru import goals, point_truth, rms_about_mean
-from ..errors import check_choice, check_range
+from ..errors import ParameterError, check_choice, check_range
 from ..frames import G, rot_nb
 from ..sea.motion_model import stack
 from .tilt_bound import SCORED_SEED, TRAIN_SEEDS, BoundSetup, angle_changes, block_rows, channels, fit, record
@@ -186,7 +186,9 @@ def gyro_tilt(rec: dict[str, np.ndarray], dt: float, crossover: float = GYRO_CRO
     the crossover): what any attitude smoother fed this gyro keeps in the wave band, where the
     aid's information on the tilt (the horizontal acceleration, known to ω² times the motion's
     error) is worth less than the gyro's (``docs/decisions/mru-design.md``). ``dt``: the
-    record's sample interval [s]."""
+    record's sample interval [s]. Zero-phase, so not causal (its magnitude is the
+    Butterworth's squared, fourth order): a smoother's tilt, what :func:`axis_floor` takes
+    with ``lag`` > 0."""
     w = stack(rec, "imu.gyro")
     phi, theta = rec["truth.roll"], rec["truth.pitch"]
     sf, cf = np.sin(phi), np.cos(phi)
@@ -206,6 +208,8 @@ def level_specific_force(rec: dict[str, np.ndarray], tilt: str = "true", dt: flo
     ``dt`` the record's sample interval [s]."""
     check_choice("tilt", tilt, TILTS)
     roll, pitch = rec["truth.roll"], rec["truth.pitch"]
+    if tilt == "gyro" and (dt is None or not dt > 0.0):
+        raise ParameterError(f"dt: the record's sample interval (> 0 s) is needed with tilt = 'gyro', got {dt!r}")
     if tilt == "gyro":
         roll, pitch = gyro_tilt(rec, dt).T
     angles = np.column_stack([pitch, -roll, np.zeros(len(roll))])

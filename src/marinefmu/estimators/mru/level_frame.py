@@ -42,6 +42,8 @@ DERIVATIVE_WINDOW = 1.0
 #: Degree of that fit: over 1 s its endpoint first derivative errs by 0.03 / 0.27 / 1.5 % at
 #: 0.8 / 1.3 / 2 rad/s (a cubic: 0.6 / 2.5 / 8.9 %).
 DERIVATIVE_DEGREE = 4
+#: 2π.
+TWO_PI = 2.0 * math.pi
 
 
 class SlowLowPass:
@@ -134,31 +136,53 @@ class GyroTilt:
         self.tau = tau
         self.state: tuple[float, float, float, float] | None = None   # c (roll, pitch) [rad], u_{k−1} [rad/s]
         self.dt, self.alpha = math.nan, 0.0
+        self.last = (0.0, 0.0)                      # the last (roll − c_roll, pitch − c_pitch) [rad]
+        self.gap = False                            # a bad sample since the last push
 
     def push(self, roll_rate: float, pitch_rate: float, roll: float, pitch: float, dt: float) -> tuple[float, float]:
         """One good sample: the Euler rates [rad/s] and the attitude's angles [rad]; returns
-        (roll − c_roll, pitch − c_pitch) [rad]."""
+        (roll − c_roll, pitch − c_pitch) [rad], the roll's wrapped to ±π. After a bad sample
+        (:meth:`hold`) c restarts at the attitude less the last difference: the attitude coasted
+        through the gap on its last gyro sample, which c did not see, and a − c would otherwise
+        jump by what the attitude moved and take τ to recover."""
         if self.state is None:
             self.state = (roll, pitch, roll_rate, pitch_rate)
-            return 0.0, 0.0
+            self.last = (0.0, 0.0)
+            return self.last
+        if self.gap:
+            self.gap = False
+            d0, d1 = self.last
+            self.state = (roll - d0, pitch - d1, roll_rate, pitch_rate)
+            return self.last
         if dt != self.dt:
             self.dt, self.alpha = dt, 1.0 - math.exp(-dt / self.tau)
         alpha, h = self.alpha, 0.5 * dt
         c0, c1, u0, u1 = self.state
         c0 += h * (u0 + roll_rate)
         c1 += h * (u1 + pitch_rate)
-        c0 += alpha * (roll - c0)
+        c0 += alpha * math.remainder(roll - c0, TWO_PI)
         c1 += alpha * (pitch - c1)
         self.state = (c0, c1, roll_rate, pitch_rate)
-        return roll - c0, pitch - c1
+        self.last = (math.remainder(roll - c0, TWO_PI), pitch - c1)
+        return self.last
+
+    def hold(self) -> None:
+        """A bad sample: nothing is integrated; the next :meth:`push` keeps the last difference."""
+        if self.state is not None:
+            self.gap = True
 
     def get_state(self) -> list | None:
         """JSON-serialisable state."""
-        return None if self.state is None else list(self.state)
+        return None if self.state is None else [*self.state, *self.last, self.gap]
 
     def set_state(self, s: list | None) -> None:
         """Restore a state from :meth:`get_state`."""
-        self.state = None if s is None else tuple(float(v) for v in s)
+        if s is None:
+            self.state = None
+            return
+        self.state = tuple(float(v) for v in s[:4])
+        self.last = (float(s[4]), float(s[5])) if len(s) > 4 else (0.0, 0.0)
+        self.gap = bool(s[6]) if len(s) > 6 else False
 
 
 def yaw_rotation(yaw: float) -> np.ndarray:

@@ -35,8 +35,11 @@ MOTION_MODELS = ("joint", "axis")
 JOINT_MEMORY = 60.0
 #: Crossover of the horizontal axes' tilt between the attitude and the integrated gyro [s]
 #: (:class:`~.level_frame.GyroTilt`): far below the wave band (a 5-20 s sea), so that the
-#: wave-frequency tilt is the gyro's, and short beside the gyro bias's wander.
+#: wave-frequency tilt is the gyro's; 30-300 s move the benchmark by under 0.03 cm.
 TILT_TAU = 100.0
+#: Shortest non-zero ``tilt_tau`` [s]: below it the crossover reaches the waves (a 5 s wave
+#: is at 1/(ωτ) = 8 % of a first-order crossover at 10 s).
+TILT_TAU_MIN = 10.0
 
 
 def default_motion() -> HeaveObserverParams:
@@ -55,7 +58,8 @@ class MotionReferenceUnitParams:
     attitude : AttitudeEstimatorParams
         The attitude estimator's (its defaults: drift-corrected, sized from the data).
     motion : HeaveObserverParams
-        The filter of each level-frame axis (``model`` must be ``"wiener"``; uses the fields
+        The filter of each level-frame axis (surge and sway with the gyro tilt's noise added to
+        ``offset_noise`` when ``tilt_tau`` > 0; ``model`` must be ``"wiener"``; uses the fields
         :class:`~marinefmu.estimators.heave.wiener.WienerAxis` names); ``smoother_lag`` is the
         delay of the delayed outputs, [0, 120] s, :data:`DELAYED_LAG` by default.
         [``window``, ``window_max``, ``omega_min``, ``omega_max``, ``acc_noise``,
@@ -82,8 +86,10 @@ class MotionReferenceUnitParams:
         [``aid_reference``]
     tilt_tau : float
         The horizontal axes' acceleration is turned with a tilt that follows the attitude below
-        1/τ and the integrated gyro above it (:class:`~.level_frame.GyroTilt`), [0, 3600] s
-        (:data:`TILT_TAU`); 0 turns it with the attitude's own tilt. [``tilt_tau``]
+        1/τ and the integrated gyro above it (:class:`~.level_frame.GyroTilt`), 0 or
+        [:data:`TILT_TAU_MIN`, 3600] s (:data:`TILT_TAU`); 0 turns it with the attitude's own
+        tilt. With it the surge and sway filters add the gyro tilt's noise to their design's
+        ``offset_noise`` (:func:`~.unit.horizontal_params`). [``tilt_tau``]
     """
 
     attitude: AttitudeEstimatorParams = field(default_factory=AttitudeEstimatorParams)
@@ -115,6 +121,9 @@ class MotionReferenceUnitParams:
         check_choice("motion_model", self.motion_model, MOTION_MODELS)
         check_range("joint_memory", self.joint_memory, lo=10.0, hi=300.0, unit="s")
         check_range("tilt_tau", self.tilt_tau, lo=0.0, hi=3600.0, unit="s")
+        if 0.0 < self.tilt_tau < TILT_TAU_MIN:
+            raise ParameterError(f"tilt_tau must be 0 (the attitude's own tilt) or in [{TILT_TAU_MIN:g}, 3600] s, "
+                                 f"got {self.tilt_tau:g} s")
         if not isinstance(self.aid_reference, (bool, np.bool_)):
             raise ParameterError(f"aid_reference must be true or false, got {self.aid_reference!r}")
 

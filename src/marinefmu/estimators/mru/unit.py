@@ -67,7 +67,8 @@ design per interval in all, as the HeaveObserver), so that no step designs more 
 
 Bad samples (NaN, Inf, absurd; the AttitudeEstimator's checks): the attitude coasts on the last
 good sample, each axis takes the window's mean acceleration (its estimate decays rather than
-drifts), the points keep the last good attitude, ``valid`` and ``motion_valid`` are false and
+drifts), the points keep the last good attitude, the gyro's tilt keeps its last difference from
+the attitude (:meth:`~.level_frame.GyroTilt.hold`), ``valid`` and ``motion_valid`` are false and
 the step's ``warning`` says why (also logged). A bad heading sample (while ``heading_valid``)
 is not used: the yaw's correction coasts and ``valid`` is false for that step. While the attitude levels (the first
 ``attitude.level_time`` s) the axes take no acceleration either: the tilt is not yet known.
@@ -111,9 +112,14 @@ def yaw_filter_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
                    offset_noise=min(10.0, a.gyro_bias_sigma * math.sqrt(2.0 / a.gyro_bias_tau)))
 
 
-def horizontal_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
+def horizontal_params(params: MotionReferenceUnitParams, gyro_noise: float | None = None,
+                      gyro_bias_sigma: float | None = None) -> HeaveObserverParams:
     """The surge and sway filters' parameters: the motion's, with the gyro's error in the
     offset's random walk when the axes take the gyro's tilt (``tilt_tau`` > 0).
+
+    ``gyro_noise``, ``gyro_bias_sigma``: the gyro's figures as the attitude has sized them
+    (``gyro_noise_used``, ``gyro_bias_sigma_used``; the unit passes them before each surge and
+    sway design); the attitude's parameters if None.
 
     The tilt's error in the wave band is then the integrated gyro's: g times it is an offset of
     the horizontal acceleration, which the filters' design takes as noise (the sensor's
@@ -129,7 +135,9 @@ def horizontal_params(params: MotionReferenceUnitParams) -> HeaveObserverParams:
     if params.tilt_tau <= 0.0:
         return params.motion
     a, m = params.attitude, params.motion
-    tilt_density = G * math.sqrt(a.gyro_noise**2 + 2.0 * a.gyro_bias_sigma**2 / (a.gyro_bias_tau * m.omega_min**2))
+    n_g = a.gyro_noise if gyro_noise is None else gyro_noise
+    sigma_b = a.gyro_bias_sigma if gyro_bias_sigma is None else gyro_bias_sigma
+    tilt_density = G * math.sqrt(n_g**2 + 2.0 * sigma_b**2 / (a.gyro_bias_tau * m.omega_min**2))
     return replace(m, offset_noise=math.hypot(m.offset_noise, tilt_density))
 
 
@@ -282,13 +290,19 @@ class MotionReferenceUnit:
                     values.append(euler[2])
                 if tilt is not None:                   # the horizontal axes' tilt: the gyro's in the wave band
                     d_roll, d_pitch = tilt.push(euler[0], euler[1], att.roll, att.pitch, dt)
-                    values[0] += G * d_pitch
-                    values[1] -= G * d_roll
+                    # g [dθ, −dφ] in the heading frame, turned into the level frame by ψ − ψ̄
+                    delta = self.yaw - self.psi_bar
+                    cos_d, sin_d = math.cos(delta), math.sin(delta)
+                    values[0] += G * (cos_d * d_pitch + sin_d * d_roll)
+                    values[1] += G * (sin_d * d_pitch - cos_d * d_roll)
+                    self._size_tilt_noise()
             elif points:
                 values.append(euler_yaw_rate(rates, att))
         else:
             heave_acc = None
             values = [None] * (4 if points else 3)
+            if self.gyro_tilt is not None:
+                self.gyro_tilt.hold()
         out = self.group.push(values)                  # (axes, 4): position, rate, delayed position, rate
         ring = self.turn_ring
         n = len(ring) // 2
@@ -364,6 +378,16 @@ class MotionReferenceUnit:
         return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], at[3, 2::3], motion[2], self.delay_s,
                          heave_axis.peak_period, angles_valid, good, delayed_valid, heading_used, warning,
                          now is not None)
+
+    def _size_tilt_noise(self) -> None:
+        """Before a surge or sway design: that filter's parameters from the gyro's noise as the
+        attitude sizes it from the data now (``gyro_noise_used``, ``gyro_bias_sigma_used``;
+        :func:`horizontal_params`), so that a quieter gyro than the default's is not designed
+        for. Only on the steps whose push designs (a dataclass replace costs microseconds)."""
+        for axis in self.axes[:2]:
+            if axis.k + 1 >= axis.next_detect:
+                att = self.attitude
+                axis.params = horizontal_params(self.params, att.gyro_noise_used, att.gyro_bias_sigma_used)
 
     def _aid_reference(self, now: np.ndarray) -> tuple[float, float, float, float]:
         """The joint filter's horizontal position and velocity ``now`` (2, 3) [m, m/s, level
