@@ -197,18 +197,26 @@ def print_mru(rows: list[dict]) -> dict:
     return {"over_goal": over, "delayed_over": delayed_over, "n_cases": len(rows)}
 
 
-def filter_feed(gyro: np.ndarray, acc: np.ndarray,
-                params: MotionReferenceUnitParams) -> tuple[list[list[float | None]], list[np.ndarray | None]]:
+def filter_feed(gyro: np.ndarray, acc: np.ndarray, params: MotionReferenceUnitParams
+                ) -> tuple[list[list[float | None]], list[np.ndarray | None], dict[int, tuple]]:
     """What a MotionReferenceUnit run over the IMU samples ``gyro``, ``acc`` (N, 3) gives its
     motion filters (:class:`~marinefmu.estimators.heave.wiener.WienerGroup`) step by step, the
-    level-frame accelerations and, with points, the yaw rate, and what they return (copies)."""
+    level-frame accelerations and, with points, the yaw rate, what they return (copies), and
+    the filters' parameters at each step where the unit changed them (the surge and sway
+    filters' noise, sized before their designs: ``MotionReferenceUnit._size_tilt_noise``)."""
     unit = MotionReferenceUnit(params, quiet=True)
     fed: list[list[float | None]] = []
     got: list[np.ndarray | None] = []
+    sizing: dict[int, tuple] = {}
     unit.start(DT)
     push = unit.group.push
+    last = tuple(axis.params for axis in unit.group.axes)
 
     def recorded(values):
+        nonlocal last
+        now = tuple(axis.params for axis in unit.group.axes)
+        if any(a is not b for a, b in zip(now, last)):
+            sizing[len(fed)] = last = now
         out = push(values)
         fed.append(list(values))
         got.append(None if out is None else out.copy())
@@ -217,15 +225,31 @@ def filter_feed(gyro: np.ndarray, acc: np.ndarray,
     unit.group.push = recorded
     for k in range(len(acc)):
         unit.step(gyro[k], acc[k], DT)
-    return fed, got
+    return fed, got, sizing
 
 
-def replay_filters(fed: list[list[float | None]], params: MotionReferenceUnitParams) -> list[np.ndarray | None]:
-    """The unit's motion filters, fresh, fed ``fed`` (:func:`filter_feed`): their outputs."""
+def fresh_filters(params: MotionReferenceUnitParams):
+    """A fresh unit's motion filters (its :class:`~marinefmu.estimators.heave.wiener.WienerGroup`),
+    started at :data:`~.defaults.DT`."""
     unit = MotionReferenceUnit(params, quiet=True)
     unit.start(DT)
-    push = unit.group.push
-    return [push(values) for values in fed]
+    return unit.group
+
+
+def replay_step(group, fed: list[list[float | None]], sizing: dict[int, tuple], k: int) -> np.ndarray | None:
+    """Step ``k`` of the replay: the parameters the unit set before it, if any, then the push."""
+    if k in sizing:
+        for axis, p in zip(group.axes, sizing[k]):
+            axis.params = p
+    return group.push(fed[k])
+
+
+def replay_filters(fed: list[list[float | None]], params: MotionReferenceUnitParams,
+                   sizing: dict[int, tuple] | None = None) -> list[np.ndarray | None]:
+    """The unit's motion filters, fresh, fed ``fed`` with the parameters ``sizing``
+    (:func:`filter_feed`): their outputs."""
+    group = fresh_filters(params)
+    return [replay_step(group, fed, sizing or {}, k) for k in range(len(fed))]
 
 
 def cost_per_step(steps: int = 30000, warm: int = 100000) -> dict[str, float]:
@@ -264,14 +288,9 @@ def cost_per_step(steps: int = 30000, warm: int = 100000) -> dict[str, float]:
                               imu_step),
               "attitude_us": (AttitudeEstimator, imu_step),
               "heave_us": (lambda: HeaveObserver(quiet=True), lambda m, k: m.step(acc[k], roll[k], pitch[k], DT))}
-    fed, _ = filter_feed(gyro, acc, MotionReferenceUnitParams())
-
-    def fresh_filters():
-        unit = MotionReferenceUnit(quiet=True)
-        unit.start(DT)
-        return unit.group
-
-    models["filters_us"] = (fresh_filters, lambda group, k: group.push(fed[k]))
+    fed, _, sizing = filter_feed(gyro, acc, MotionReferenceUnitParams())
+    models["filters_us"] = (lambda: fresh_filters(MotionReferenceUnitParams()),
+                            lambda group, k: replay_step(group, fed, sizing, k))
     best = dict.fromkeys(models, math.inf)
     taught = True
     for _ in range(2):
