@@ -67,7 +67,6 @@ from ..bench.mru import POINTS as MRU_POINTS
 from ..bench.mru import goals, point_truth, rms_about_mean
 from ..errors import ParameterError, check_choice, check_range
 from ..frames import G, rot_nb
-from ..sea.motion_model import stack
 from .tilt_bound import SCORED_SEED, TRAIN_SEEDS, BoundSetup, angle_changes, block_rows, channels, fit, record
 
 #: Fitted targets: the IMU's NED position [m] and the ZYX Euler angles [rad].
@@ -178,7 +177,8 @@ def causal_motion_bound(hs: float, tp: float, preset: str = "polar_supply", leve
             "features": weights.shape[0], "rows": sum(len(x) for x, _ in pairs), "scored": scored}
 
 
-def gyro_tilt(rec: dict[str, np.ndarray], dt: float, crossover: float = GYRO_CROSSOVER) -> np.ndarray:
+def gyro_tilt(rec: dict[str, np.ndarray], dt: float, crossover: float = GYRO_CROSSOVER,
+              linear: np.ndarray | None = None) -> np.ndarray:
     """(N, 2) roll and pitch [rad] that are the truth below ``crossover`` [Hz] and the integrated
     gyro above it: θ + HP(∫u − θ), u the Euler rates of the measured gyro (turned with the true
     attitude), HP scipy's zero-phase second-order Butterworth high-pass. Its only error is the
@@ -188,13 +188,9 @@ def gyro_tilt(rec: dict[str, np.ndarray], dt: float, crossover: float = GYRO_CRO
     error) is worth less than the gyro's (``docs/decisions/mru-design.md``). ``dt``: the
     record's sample interval [s]. Zero-phase, so not causal (its magnitude is the
     Butterworth's squared, fourth order): a smoother's tilt, what :func:`axis_floor` takes
-    with ``lag`` > 0."""
-    w = stack(rec, "imu.gyro")
-    phi, theta = rec["truth.roll"], rec["truth.pitch"]
-    sf, cf = np.sin(phi), np.cos(phi)
-    p, q, r = w.T
-    rates = np.column_stack([p + (q * sf + r * cf) * np.tan(theta), q * cf - r * sf])
-    truth = np.column_stack([phi, theta])
+    with ``lag`` > 0. ``linear``: ``channels(rec)`` if already computed (its Euler rates are u)."""
+    rates = (channels(rec) if linear is None else linear)[:, :2]
+    truth = np.column_stack([rec["truth.roll"], rec["truth.pitch"]])
     sos = butter(2, crossover, "high", fs=1.0 / dt, output="sos")
     return truth + sosfiltfilt(sos, angle_changes(rates, dt) - truth, axis=0)
 
@@ -207,13 +203,14 @@ def level_specific_force(rec: dict[str, np.ndarray], tilt: str = "true", dt: flo
     :func:`gyro_tilt` (first order, as the linearised channel: f + g [θ − θ_c, −(φ − φ_c), 0]),
     ``dt`` the record's sample interval [s]."""
     check_choice("tilt", tilt, TILTS)
+    linear = channels(rec)
     roll, pitch = rec["truth.roll"], rec["truth.pitch"]
-    if tilt == "gyro" and (dt is None or not dt > 0.0):
-        raise ParameterError(f"dt: the record's sample interval (> 0 s) is needed with tilt = 'gyro', got {dt!r}")
     if tilt == "gyro":
-        roll, pitch = gyro_tilt(rec, dt).T
+        if dt is None or not dt > 0.0:
+            raise ParameterError(f"dt: the record's sample interval (> 0 s) is needed with tilt = 'gyro', got {dt!r}")
+        roll, pitch = gyro_tilt(rec, dt, linear=linear).T
     angles = np.column_stack([pitch, -roll, np.zeros(len(roll))])
-    return channels(rec)[:, 3:] - G * angles + np.array([0.0, 0.0, G])
+    return linear[:, 3:] - G * angles + np.array([0.0, 0.0, G])
 
 
 def axis_floor(hs: float, tp: float, preset: str = "polar_supply", lever_arm=(0.0, 0.0, 0.0),

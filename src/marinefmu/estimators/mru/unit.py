@@ -204,6 +204,7 @@ class MotionReferenceUnit:
         self.joint: JointMotion | None = None
         self.psi_bar = 0.0                            # ψ̄, the level frame's reference yaw [rad]
         self.gyro_tilt = GyroTilt(p.tilt_tau) if p.tilt_tau > 0.0 else None
+        self.next_sizing = 0                          # the sample count of the next surge or sway design
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -295,7 +296,8 @@ class MotionReferenceUnit:
                     cos_d, sin_d = math.cos(delta), math.sin(delta)
                     values[0] += G * (cos_d * d_pitch + sin_d * d_roll)
                     values[1] += G * (sin_d * d_pitch - cos_d * d_roll)
-                    self._size_tilt_noise()
+                    if self.axes[0].k + 1 >= self.next_sizing:     # a surge or sway design may be due
+                        self._size_tilt_noise()
             elif points:
                 values.append(euler_yaw_rate(rates, att))
         else:
@@ -383,11 +385,15 @@ class MotionReferenceUnit:
         """Before a surge or sway design: that filter's parameters from the gyro's noise as the
         attitude sizes it from the data now (``gyro_noise_used``, ``gyro_bias_sigma_used``;
         :func:`horizontal_params`), so that a quieter gyro than the default's is not designed
-        for. Only on the steps whose push designs (a dataclass replace costs microseconds)."""
-        for axis in self.axes[:2]:
+        for. Only on the steps whose push designs (a dataclass replace costs microseconds):
+        called from ``next_sizing`` on, which it moves to the next design (on the step after a
+        design, once the design has moved its axis's ``next_detect``)."""
+        horizontal = self.axes[:2]
+        for axis in horizontal:
             if axis.k + 1 >= axis.next_detect:
                 att = self.attitude
                 axis.params = horizontal_params(self.params, att.gyro_noise_used, att.gyro_bias_sigma_used)
+        self.next_sizing = min(axis.next_detect for axis in horizontal)
 
     def _aid_reference(self, now: np.ndarray) -> tuple[float, float, float, float]:
         """The joint filter's horizontal position and velocity ``now`` (2, 3) [m, m/s, level
