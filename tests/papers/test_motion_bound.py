@@ -8,9 +8,11 @@ import pytest
 
 from marinefmu.bench import mru as bench
 from marinefmu.errors import ParameterError
+from marinefmu.estimators.mru.goals import goals, rms_about_mean
 from marinefmu.estimators.mru.params import MotionReferenceUnitParams
 from marinefmu.papers import motion_bound as mb
 from marinefmu.papers import tilt_bound as tb
+from marinefmu.sea.motion_model import point_truth
 
 #: Short records (the module's defaults train on 3 × 1 h): two 15-minute training records, a
 #: 10-minute scored record from 3 minutes on, a 2-minute memory. Less training leaves a less well
@@ -48,7 +50,7 @@ def hs6():
     true_attitude = bench.true_attitude_cm(rec, MotionReferenceUnitParams(), k0)
     out = bench.run_mru(rec, MotionReferenceUnitParams(points=mb.POINTS[1:]))
     k0 = max(k0, int(np.argmax(out["valid"])))
-    unit = [100 * bench.rms_about_mean(out["position"][k0:, j] - bench.point_truth(rec, arm)[0][k0:])
+    unit = [100 * rms_about_mean(out["position"][k0:, j] - point_truth(rec, arm)[0][k0:])
             for j, arm in enumerate(mb.POINTS)]
     return {"bound": bound, "floor": np.array(floor), "true_attitude": np.array(true_attitude), "unit": unit}
 
@@ -81,7 +83,7 @@ def test_the_points_are_turned_as_the_truths(hs3):
     there is its own."""
     rec = hs3["mems"]["scored"]
     ends = SETUP.ends(len(rec["truth.roll"]), SETUP.settle)
-    truth, _ = bench.point_truth({k: v[ends] for k, v in rec.items()}, mb.POINTS[1])
+    truth, _ = point_truth({k: v[ends] for k, v in rec.items()}, mb.POINTS[1])
     np.testing.assert_allclose(mb.point_positions(mb.targets(rec, ends), mb.POINTS[1]), truth, rtol=0, atol=1e-9)
 
 
@@ -125,6 +127,10 @@ def test_the_delayed_floor_is_well_below_half_the_real_time_floor():
     for j in range(len(mb.POINTS)):
         assert np.all(bounds(late, j) <= 0.35 * bounds(now, j)), (bounds(late, j), bounds(now, j))
     assert np.all(np.array(late["angles_deg"]) <= 0.5 * np.array(now["angles_deg"]))
+    # the real-time goal is the bench's with this bound; a lag has none of its own
+    for point in now["points"]:
+        np.testing.assert_allclose(point["goal_cm"], goals(np.array(point["std_cm"]), np.array(point["bound_cm"])))
+    assert all(point["goal_cm"] is None for point in late["points"])
     with pytest.raises(ParameterError, match="lag"):
         mb.causal_motion_bound(3.0, 10.0, "polar_supply", setup=SETUP, motions=motions, lag=SETUP.memory, **SHORT)
 

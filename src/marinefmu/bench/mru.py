@@ -6,20 +6,16 @@ three benchmark seas × the IMU at the COG and far from it), default MEMS IMU, o
 :data:`DURATION` s, scored from the first sample the joint filter gives (``motion.joint``; at
 the defaults and 100 Hz after about 15 minutes) or, if it never does, from
 :data:`~.defaults.SETTLE` s or the first valid sample, whichever is later: the goals are the
-unit's accuracy once settled, as a datasheet's. The monitoring points (:data:`POINTS`, relative
-to the IMU, body frame) reach 59.8 m from the IMU.
+unit's accuracy once settled, as a datasheet's. The monitoring points
+(:data:`~marinefmu.estimators.mru.goals.POINTS`, relative to the IMU, body frame) reach 59.8 m
+from the IMU.
 
-Each figure is an RMS error with the truth's and the error's means removed (motion about the
-mean position; the filters have no output at zero frequency), against the truth's standard
-deviation on the same axis (not the amplitude: a vendor's "5 % of amplitude" is 5 % of about
-√2 σ for a sinusoid, 2σ for Hs = 4σ of a sea, so their percentages are looser than ours by
-that factor). The goals (:func:`goals`): roll and pitch as the AttitudeEstimator at its
-defaults (it is that estimator); real-time heave ≤ max(2 cm, 2.5 % of std), or ≤
-:data:`BOUND_FACTOR` × the causal bound where that is higher (:func:`case_bound`: the
-least-variance causal linear estimate of the point's motion from this IMU,
-:func:`marinefmu.papers.motion_bound.causal_motion_bound`, on its own records of the same sea,
-vessel, IMU and placement), surge and sway ≤ max(2 cm, 5 % of std) at every point; the delayed
-outputs ≤ half the real-time error.
+The goals are :mod:`marinefmu.estimators.mru.goals`' (RMS errors about the mean against the
+truth's std; :func:`~marinefmu.estimators.mru.goals.goals`), with roll and pitch as the
+AttitudeEstimator at its defaults (it is that estimator). The heave goal's causal bound is
+:func:`case_bound`'s: the least-variance causal linear estimate of the point's motion from this
+IMU (:func:`marinefmu.papers.motion_bound.causal_motion_bound`) on its own records of the same
+sea, vessel, IMU and placement.
 """
 from __future__ import annotations
 
@@ -27,36 +23,18 @@ import math
 
 import numpy as np
 
+from ..estimators.mru.goals import POINTS, goals, rms_about_mean
 from ..estimators.mru.params import MotionReferenceUnitParams
 from ..estimators.mru.unit import AXES, MotionReferenceUnit
 from ..frames import rot_nb
-from ..sea.motion_model import stack
+from ..papers.motion_bound import causal_motion_bound
+from ..sea.motion_model import point_truth, stack
 from .defaults import CASES, DT, SETTLE, case_record, placements
 
 #: Length of each case's record [s]: the joint filter's first fit (two rows per weight, 640 s of
 #: taught rows at the defaults, after the axis filters' first delayed output at about 175 s) and
 #: then 15 minutes scored.
 DURATION = 1800.0
-
-#: Monitoring points relative to the IMU, body frame [m]: a point near the IMU, one aft and to
-#: port, one high on the beam, and one 59.8 m forward and above (a crane or gangway tip on the
-#: longest lever arm the goals cover).
-POINTS: tuple[tuple[float, float, float], ...] = ((20.0, 5.0, -5.0), (-30.0, -8.0, -10.0), (0.0, 10.0, -20.0),
-                                                  (59.0, 0.0, -10.0))
-
-
-def point_truth(rec: dict[str, np.ndarray], arm: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
-    """True position and velocity [m], [m/s] (N, 3) of the point at ``arm`` from the IMU (body
-    frame) in VesselMotion's NED, whose north is the mean heading: surge, sway, heave of the
-    vessel's level frame."""
-    r = np.asarray(arm, dtype=float)
-    angles = np.column_stack([rec["truth.roll"], rec["truth.pitch"], rec["truth.yaw"]])
-    rots = np.array([rot_nb(*a) for a in angles])
-    rate = stack(rec, "truth.rate")
-    pos = stack(rec, "truth.imu", "ned") + rots @ r
-    vel = stack(rec, "truth.imu_vel", "ned") + np.einsum("nij,nj->ni", rots, np.cross(rate, r))
-    return pos, vel
-
 
 def run_mru(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams) -> dict[str, np.ndarray]:
     """The MotionReferenceUnit over a VesselMotion record: (N, ·) arrays of every output."""
@@ -102,31 +80,10 @@ def true_attitude_cm(rec: dict[str, np.ndarray], params: MotionReferenceUnitPara
     return (100 * rms_about_mean(est[k0:] - pos[k0:])).tolist()
 
 
-def rms_about_mean(err: np.ndarray) -> np.ndarray:
-    """RMS of ``err`` (N, …) over axis 0 with its mean removed."""
-    return np.sqrt(np.mean((err - err.mean(axis=0)) ** 2, axis=0))
-
-
-#: The heave goal's multiple of the causal bound, where that is above max(2 cm, 2.5 % of std).
-BOUND_FACTOR = 1.2
-
-
-def goals(std_cm: np.ndarray, bound_cm: np.ndarray | None = None) -> np.ndarray:
-    """(…, 3) goals [cm] of surge, sway, heave for truth standard deviations ``std_cm``; with
-    the causal bound ``bound_cm`` (…, 3) [cm], the heave goal is :data:`BOUND_FACTOR` × its heave
-    where that is higher."""
-    goal = np.maximum(2.0, np.asarray(std_cm) * np.array([0.05, 0.05, 0.025]))
-    if bound_cm is not None:
-        goal[..., 2] = np.maximum(goal[..., 2], BOUND_FACTOR * np.asarray(bound_cm)[..., 2])
-    return goal
-
-
 def case_bound(preset: str, hs: float, tp: float, place: str, extra: dict | None = None) -> list[list[float]]:
-    """The causal bound [cm] of surge, sway and heave at the IMU and each point of :data:`POINTS`
+    """The causal bound [cm] of surge, sway and heave at the IMU and each point of :data:`~marinefmu.estimators.mru.goals.POINTS`
     for one case (:func:`marinefmu.papers.motion_bound.causal_motion_bound` at its defaults, the
     IMU where the case puts it, ``extra`` the case's VesselMotion parameters); about 25 s."""
-    from ..papers.motion_bound import causal_motion_bound     # it imports this module
-
     bound = causal_motion_bound(hs, tp, preset, lever_arm=placements(preset)[place], points=((0.0, 0.0, 0.0), *POINTS),
                                 imu=extra)
     return [p["bound_cm"] for p in bound["points"]]
@@ -253,7 +210,7 @@ def replay_filters(fed: list[list[float | None]], params: MotionReferenceUnitPar
 
 
 def cost_per_step(steps: int = 30000, warm: int = 100000) -> dict[str, float]:
-    """In-process µs per step of the MotionReferenceUnit with the four :data:`POINTS` and with
+    """In-process µs per step of the MotionReferenceUnit with the four :data:`~marinefmu.estimators.mru.goals.POINTS` and with
     none, the AttitudeEstimator and the HeaveObserver at their defaults, on the first case's
     record: each model runs ``warm`` steps untimed (1000 s at 100 Hz: the joint filter taught,
     every spectrum window at its longest) and then ``steps`` timed (best of two runs each, the

@@ -9,7 +9,7 @@ and a constant), trained on long records of the same sea and IMU with other seed
 the checks' record. The targets are the IMU's position in VesselMotion's NED (whose north is the
 mean heading: surge, sway and heave of the level frame) and the three Euler angles; a point at
 lever arm r from the IMU is then estimated as p̂ + R_nb(φ̂, θ̂, ψ̂) r, as a real estimator turns its
-lever arms with its own attitude, and scored against :func:`~marinefmu.bench.mru.point_truth`.
+lever arms with its own attitude, and scored against :func:`~marinefmu.sea.motion_model.point_truth`.
 Least squares is linear in its targets, so to first order this is the least-squares fit of the
 point itself; a fit of the point's position would keep the rotation's second-order terms
 (r (1 − cos θ), products of the angles), which no linear function of the channels gives and
@@ -63,16 +63,17 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
-from ..bench.mru import POINTS as MRU_POINTS
-from ..bench.mru import goals, point_truth, rms_about_mean
 from ..errors import ParameterError, check_choice, check_range
+from ..estimators.mru.goals import POINTS as MRU_POINTS
+from ..estimators.mru.goals import goals, rms_about_mean
 from ..frames import G, rot_nb
+from ..sea.motion_model import point_truth
 from .tilt_bound import SCORED_SEED, TRAIN_SEEDS, BoundSetup, angle_changes, block_rows, channels, fit, record
 
 #: Fitted targets: the IMU's NED position [m] and the ZYX Euler angles [rad].
 TARGETS = ("truth.imu.n", "truth.imu.e", "truth.imu.d", "truth.roll", "truth.pitch", "truth.yaw")
 #: Monitoring points relative to the IMU, body frame [m]: the IMU itself and the MRU bench's
-#: farthest point (:data:`marinefmu.bench.mru.POINTS`), 59.8 m away.
+#: farthest point (:data:`marinefmu.estimators.mru.goals.POINTS`), 59.8 m away.
 POINTS = ((0.0, 0.0, 0.0), MRU_POINTS[-1])
 #: The rows of both fits (module docstring): the tilt bound's, with blocks of at most 2 s.
 SETUP = BoundSetup(longest=2.0)
@@ -150,8 +151,9 @@ def causal_motion_bound(hs: float, tp: float, preset: str = "polar_supply", leve
     -------
     dict
         ``points``: per point, ``arm_m``, ``bound_cm`` (RMS error about the mean of surge, sway,
-        heave [cm]), ``std_cm`` (the truth's std [cm]) and ``goal_cm``
-        (:func:`marinefmu.bench.mru.goals`); ``angles_deg`` (RMS error of roll, pitch, yaw [°]);
+        heave [cm]), ``std_cm`` (the truth's std [cm]) and ``goal_cm``, the
+        real-time goal with this bound (:func:`~marinefmu.estimators.mru.goals.goals`; None for a
+        ``lag``: the delayed goal is relative to the estimator's real-time error); ``angles_deg`` (RMS error of roll, pitch, yaw [°]);
         ``features`` and ``rows`` (training); ``scored`` (the scored record).
     """
     check_range("lag", lag, lo=0.0, hi=setup.memory, hi_open=True, unit="s")
@@ -169,9 +171,9 @@ def causal_motion_bound(hs: float, tp: float, preset: str = "polar_supply", leve
     for arm in points:
         truth, _ = point_truth(at_rows, arm)
         std = 100 * np.std(truth, axis=0)
-        out.append({"arm_m": tuple(float(a) for a in arm),
-                    "bound_cm": (100 * rms_about_mean(point_positions(est, arm) - truth)).tolist(),
-                    "std_cm": std.tolist(), "goal_cm": goals(std).tolist()})
+        bound = 100 * rms_about_mean(point_positions(est, arm) - truth)
+        out.append({"arm_m": tuple(float(a) for a in arm), "bound_cm": bound.tolist(), "std_cm": std.tolist(),
+                    "goal_cm": None if back else goals(std, bound).tolist()})
     angle_err = est[:, 3:] - targets(scored, ends - back)[:, 3:]
     return {"points": out, "angles_deg": np.degrees(np.sqrt(np.mean(angle_err ** 2, axis=0))).tolist(),
             "features": weights.shape[0], "rows": sum(len(x) for x, _ in pairs), "scored": scored}

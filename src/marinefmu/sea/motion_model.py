@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, check_choice, check_int, check_vector
-from ..frames import G, attitude_kinematics, rigid_point_operator, specific_force
+from ..frames import G, attitude_kinematics, rigid_point_operator, rot_nb, specific_force
 from ..variables import Variable, real, resolve, vec
 from .sensors import ANTENNAS, GRADE_FIGURES, IMU_GRADES, Gnss, GnssParams, Imu, ImuParams
 from .vessel import PRESET_NAMES, MotionSeries, RaoTable, check_speed, load_rao_csv, preset_raos
@@ -424,3 +424,15 @@ def stack(record: dict[str, np.ndarray], prefix: str, axes: Any = "xyz") -> np.n
     """(N, len(axes)) array of the outputs ``prefix.axis`` of a :func:`simulate_record` record,
     e.g. ``stack(rec, "imu.acc")`` or ``stack(rec, "truth", ("roll", "pitch", "yaw"))``."""
     return np.column_stack([record[f"{prefix}.{a}"] for a in axes])
+
+
+def point_truth(record: dict[str, np.ndarray], arm: Any) -> tuple[np.ndarray, np.ndarray]:
+    """True position and velocity [m], [m/s] (N, 3) of the point at ``arm`` [m] from the IMU
+    (body frame) in a :func:`simulate_record` record's NED, whose north is the mean heading:
+    surge, sway, heave of the vessel's level frame. p = p_imu + R_nb r, v = v_imu + R_nb (ω × r)."""
+    r = np.asarray(arm, dtype=float)
+    rots = np.array([rot_nb(*a) for a in stack(record, "truth", ("roll", "pitch", "yaw"))])
+    rate = stack(record, "truth.rate")
+    pos = stack(record, "truth.imu", "ned") + rots @ r
+    vel = stack(record, "truth.imu_vel", "ned") + np.einsum("nij,nj->ni", rots, np.cross(rate, r))
+    return pos, vel

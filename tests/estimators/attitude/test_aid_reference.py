@@ -9,10 +9,9 @@ import numpy as np
 import pytest
 
 from marinefmu.bench.defaults import case_record
-from marinefmu.bench.mru import point_truth
 from marinefmu.estimators.attitude import estimator as att
 from marinefmu.estimators.attitude.estimator import AttitudeEstimator, AttitudeEstimatorParams
-from marinefmu.sea.motion_model import stack
+from marinefmu.sea.motion_model import point_truth, stack
 
 DT = 0.01
 

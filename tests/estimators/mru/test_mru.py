@@ -10,10 +10,11 @@ import pytest
 
 from marinefmu import MotionReferenceUnit, MotionReferenceUnitParams, ParameterError
 from marinefmu.bench.defaults import DT, case_record
-from marinefmu.bench.mru import point_truth, rms_about_mean, run_mru
+from marinefmu.bench.mru import run_mru
 from marinefmu.estimators.attitude.estimator import AttitudeEstimatorParams
 from marinefmu.estimators.heave.common import HeaveObserverParams
-from marinefmu.sea.motion_model import stack
+from marinefmu.estimators.mru.goals import rms_about_mean
+from marinefmu.sea.motion_model import point_truth, stack
 
 ARMS = ((20.0, 5.0, -5.0), (59.0, 0.0, -10.0))
 

@@ -1,8 +1,8 @@
-"""The MotionReferenceUnit benchmark's goals: max(2 cm, 5 % / 5 % / 2.5 % of std), the heave
+"""The MotionReferenceUnit's goals: max(2 cm, 5 % / 5 % / 2.5 % of std), the heave
 goal raised to 1.2 × the causal bound where that is higher (issue's definition)."""
 import numpy as np
 
-from marinefmu.bench.mru import BOUND_FACTOR, goals
+from marinefmu.estimators.mru.goals import BOUND_FACTOR, goals
 
 
 def test_the_heave_goal_follows_the_causal_bound_where_it_is_higher():
