@@ -11,7 +11,10 @@ module                     holds
 :mod:`.params`             parameters, their checks, the result of a step
 :mod:`.level_frame`        the level frame, the slow low-pass, the lever-arm terms and
                            their derivatives
+:mod:`.joint`              the joint motion filter: all six IMU channels, taught by the
+                           axis filters' delayed outputs
 :mod:`.unit`               :class:`~.unit.MotionReferenceUnit`: the MotionReferenceUnit
                            FMU's model
+:mod:`.goals`              the accuracy goals and the monitoring points they are scored at
 ========================== ===============================================================
 """
