@@ -81,9 +81,10 @@ def true_attitude_cm(rec: dict[str, np.ndarray], params: MotionReferenceUnitPara
 
 
 def case_bound(preset: str, hs: float, tp: float, place: str, extra: dict | None = None) -> list[list[float]]:
-    """The causal bound [cm] of surge, sway and heave at the IMU and each point of :data:`~marinefmu.estimators.mru.goals.POINTS`
-    for one case (:func:`marinefmu.papers.motion_bound.causal_motion_bound` at its defaults, the
-    IMU where the case puts it, ``extra`` the case's VesselMotion parameters); about 25 s."""
+    """The causal bound [cm] of surge, sway and heave at the IMU and each monitoring point
+    (:data:`~marinefmu.estimators.mru.goals.POINTS`) for one case
+    (:func:`marinefmu.papers.motion_bound.causal_motion_bound` at its defaults, the IMU where the
+    case puts it, ``extra`` the case's VesselMotion parameters); about 25 s."""
     bound = causal_motion_bound(hs, tp, preset, lever_arm=placements(preset)[place], points=((0.0, 0.0, 0.0), *POINTS),
                                 imu=extra)
     return [p["bound_cm"] for p in bound["points"]]
@@ -210,8 +211,8 @@ def replay_filters(fed: list[list[float | None]], params: MotionReferenceUnitPar
 
 
 def cost_per_step(steps: int = 30000, warm: int = 100000) -> dict[str, float]:
-    """In-process µs per step of the MotionReferenceUnit with the four :data:`~marinefmu.estimators.mru.goals.POINTS` and with
-    none, the AttitudeEstimator and the HeaveObserver at their defaults, on the first case's
+    """In-process µs per step of the MotionReferenceUnit with the four monitoring points
+    (:data:`~marinefmu.estimators.mru.goals.POINTS`) and with none, the AttitudeEstimator and the HeaveObserver at their defaults, on the first case's
     record: each model runs ``warm`` steps untimed (1000 s at 100 Hz: the joint filter taught,
     every spectrum window at its longest) and then ``steps`` timed (best of two runs each, the
     models taking turns; the design, refit and bias-step work amortised over the timed steps,

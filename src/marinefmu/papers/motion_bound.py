@@ -9,7 +9,8 @@ and a constant), trained on long records of the same sea and IMU with other seed
 the checks' record. The targets are the IMU's position in VesselMotion's NED (whose north is the
 mean heading: surge, sway and heave of the level frame) and the three Euler angles; a point at
 lever arm r from the IMU is then estimated as p̂ + R_nb(φ̂, θ̂, ψ̂) r, as a real estimator turns its
-lever arms with its own attitude, and scored against :func:`~marinefmu.sea.motion_model.point_truth`.
+lever arms with its own attitude, and scored against
+:func:`~marinefmu.sea.motion_model.point_truth`.
 Least squares is linear in its targets, so to first order this is the least-squares fit of the
 point itself; a fit of the point's position would keep the rotation's second-order terms
 (r (1 − cos θ), products of the angles), which no linear function of the channels gives and
@@ -151,10 +152,11 @@ def causal_motion_bound(hs: float, tp: float, preset: str = "polar_supply", leve
     -------
     dict
         ``points``: per point, ``arm_m``, ``bound_cm`` (RMS error about the mean of surge, sway,
-        heave [cm]), ``std_cm`` (the truth's std [cm]) and ``goal_cm``, the
-        real-time goal with this bound (:func:`~marinefmu.estimators.mru.goals.goals`; None for a
-        ``lag``: the delayed goal is relative to the estimator's real-time error); ``angles_deg`` (RMS error of roll, pitch, yaw [°]);
-        ``features`` and ``rows`` (training); ``scored`` (the scored record).
+        heave [cm]), ``std_cm`` (the truth's std [cm]) and ``goal_cm``, the real-time goal
+        with this bound (:func:`~marinefmu.estimators.mru.goals.goals`; None for a ``lag``: the
+        delayed goal is relative to the estimator's real-time error); ``angles_deg`` (RMS error
+        of roll, pitch, yaw [°]); ``features`` and ``rows`` (training); ``scored`` (the scored
+        record).
     """
     check_range("lag", lag, lo=0.0, hi=setup.memory, hi_open=True, unit="s")
     back = int(round(lag / setup.dt))
