@@ -2,7 +2,7 @@
 fed what the unit fed its own returns what the unit's returned, designs included."""
 import numpy as np
 
-from marinefmu.bench.defaults import CASES, case_record
+from marinefmu.bench.cases import CASES, case_record
 from marinefmu.bench.mru import filter_feed, replay_filters
 from marinefmu.estimators.mru.goals import POINTS
 from marinefmu.estimators.mru.params import MotionReferenceUnitParams

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from tests.conftest import DT, Driver
 
-from marinefmu.bench.defaults import case_record
+from marinefmu.bench.cases import case_record
 from marinefmu.estimators.mru.unit import MotionReferenceUnit
 from marinefmu.fmu.tables import mru_params
 from marinefmu.sea.motion_model import stack

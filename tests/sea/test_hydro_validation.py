@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from marinefmu.bench.defaults import SEAS
+from marinefmu.bench.cases import SEAS
 from marinefmu.sea.hydro.export import PEAK_HEADING_DEG
 from marinefmu.sea.hydro.presets import BEM_PRESETS
 from marinefmu.sea.hydro.validation import tail_bound

@@ -2,22 +2,21 @@
 best fixed setting the project knows, on a grid of vessels, seas and IMU placements.
 
 A user who drops an FMU into a system sets what only they know (lever arms) and leaves the
-rest. This part measures what that user gets. The grid (:data:`CASES`) is the three vessel
-presets × three seas (:data:`SEAS`: Hs 1 m / Tp 5 s, 3 m / 10 s, 6 m / 14 s, bow-quartering)
-× two IMU placements (:func:`placements`: at the COG, and 40 % of the length forward, 40 % of
-the beam to starboard and 10 m above the COG), default MEMS IMU, one seed per case.
+rest. This part measures what that user gets, on the grid of :mod:`.cases`
+(:data:`~.cases.CASES`: the three vessel presets × three seas × two IMU placements, default MEMS
+IMU, one seed per case).
 
 AttitudeEstimator: roll and pitch RMS over ``[SETTLE, duration]`` at the defaults
 (``aid_sizing = "auto"``) and with each fixed aiding of :data:`ATTITUDE_GRID` (σ_v 0.05 … 4 m/s,
 σ_p = 3 σ_v, 10 Hz, and the paper-000 reproduction's 3 m/s, 10 m, 1 Hz); the figure of merit is
-the larger of roll and pitch. The goals: the defaults within :data:`RATIO_GOAL` of the grid's
+the larger of roll and pitch. The goals: the defaults within :data:`~.cases.RATIO_GOAL` of the grid's
 best on every case, and at most :data:`ATTITUDE_GOAL_DEG`.
 
-HeaveObserver: given only its monitoring point (:func:`monitoring_point`, relative to the IMU), at its
+HeaveObserver: given only its monitoring point (:func:`~.cases.monitoring_point`, relative to the IMU), at its
 defaults, fed by the AttitudeEstimator at its defaults, against the same observer fed by the
 case's best fixed aiding and by the true roll and pitch (what no attitude estimate beats); the
-real-time heave RMS error at the point from :data:`SETTLE` or the observer's first valid
-sample, whichever is later (:func:`point_heave_cm`). The goals: within :data:`RATIO_GOAL` of
+real-time heave RMS error at the point from :data:`~.cases.SETTLE` or the observer's first valid
+sample, whichever is later (:func:`point_heave_cm`). The goals: within :data:`~.cases.RATIO_GOAL` of
 the best fixed aiding's, and the project's heave goal max(2 cm, 2.5 % of the point's heave std).
 
 The GnssAccFusion, DisplacementReconstructor and CentreOfRotation on the same cases are in
@@ -26,7 +25,6 @@ The GnssAccFusion, DisplacementReconstructor and CentreOfRotation on the same ca
 """
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 import numpy as np
@@ -34,52 +32,17 @@ import numpy as np
 from ..estimators.attitude.estimator import AttitudeEstimatorParams, estimate_attitude
 from ..estimators.heave.common import HeaveObserverParams
 from ..estimators.heave.observer import HeaveObserver
-from ..sea.motion_model import VesselMotionParams, simulate_record, stack
-from ..sea.vessel import PRESETS
+from ..sea.motion_model import stack
+from .cases import CASES, DT, RATIO_GOAL, SETTLE, case_record, monitoring_point, placements
 
-DT = 0.01
-SEAS = ((1.0, 5.0), (3.0, 10.0), (6.0, 14.0))
-HEADING = 0.75 * math.pi
-DURATION = 600.0
-SETTLE = 150.0
-SEED = 3
-RATIO_GOAL = 1.15
+#: The AttitudeEstimator's goal at its defaults: roll and pitch RMS [deg].
 ATTITUDE_GOAL_DEG = 0.035
+#: The fixed aiding settings the defaults are measured against (module docstring).
 ATTITUDE_GRID: tuple[dict, ...] = (
     *({"aid_sizing": "fixed", "vel_sigma": v, "pos_sigma": 3.0 * v, "aid_rate": 10.0}
       for v in (0.05, 0.1, 0.25, 0.5, 1.0, 2.0, 4.0)),
     {"aid_sizing": "fixed", "vel_sigma": 3.0, "pos_sigma": 10.0, "aid_rate": 1.0},
 )
-
-
-def placements(preset: str) -> dict[str, tuple[float, float, float]]:
-    """The two IMU positions of a preset relative to its COG, body frame [m]."""
-    h = PRESETS[preset]
-    return {"cog": (0.0, 0.0, 0.0), "far": (round(0.4 * h.length, 1), round(0.4 * h.beam, 1), -10.0)}
-
-
-def monitoring_point(preset: str, place: str) -> tuple[float, float, float]:
-    """The heave figure's monitoring point relative to the COG, body frame [m]: on the
-    centreline 10 m above the COG, 45 % of the length forward (a bow crane or gangway tip) for
-    the IMU at the COG, 45 % aft for the IMU forward (:func:`placements`), so that the point is
-    far from the IMU in both and the attitude error's lever arm is long."""
-    x = 0.45 * PRESETS[preset].length
-    return (round(x if place == "cog" else -x, 1), 0.0, -10.0)
-
-
-CASES: tuple[tuple[str, float, float, str], ...] = tuple(
-    (preset, hs, tp, place) for preset in PRESETS for hs, tp in SEAS for place in ("cog", "far"))
-
-
-def case_record(preset: str, hs: float, tp: float, place: str, duration: float = DURATION,
-                extra: dict | None = None) -> dict[str, np.ndarray]:
-    """VesselMotion record of one case (:data:`SEED`, bow-quartering); ``extra``: more
-    VesselMotion parameters (e.g. ``{"imu.grade": "mru"}``)."""
-    imu = placements(preset)[place]
-    flat = {"sea.hs": hs, "sea.tp": tp, "sea.seed": SEED, "sea.heading": HEADING, "vessel.preset": preset,
-            **{f"imu.{a}": v for a, v in zip("xyz", imu)},
-            **{f"point.{a}": v for a, v in zip("xyz", monitoring_point(preset, place))}, **(extra or {})}
-    return simulate_record(VesselMotionParams.from_flat(flat), duration, DT)
 
 
 def attitude_rms_deg(rec: dict[str, np.ndarray], params: AttitudeEstimatorParams | None = None,

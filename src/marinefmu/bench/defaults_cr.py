@@ -1,8 +1,8 @@
 """Benchmark part ``defaults``, CentreOfRotation: the estimator at its defaults, given geometry
-only, against the best of a small grid of settings, on the 18 cases of :mod:`.defaults`.
+only, against the best of a small grid of settings, on the 18 cases of :mod:`.cases`.
 
-Each case is :func:`~marinefmu.bench.defaults.case_record` (the vessel preset, sea and IMU
-placement of :data:`~marinefmu.bench.defaults.CASES`, default MEMS IMU, 600 s) in
+Each case is :func:`~marinefmu.bench.cases.case_record` (the vessel preset, sea and IMU
+placement of :data:`~marinefmu.bench.cases.CASES`, default MEMS IMU, 600 s) in
 VesselMotion's independent-rotation mode (``vessel.mode = 1``) about :data:`CR`, the set-up of
 :mod:`marinefmu.papers.paper002`: the RAO mode defines no centre of rotation, so it has no truth
 to score against. The estimator is given its ``sensor`` (the IMU placement) and nothing else.
@@ -26,14 +26,13 @@ differences below 2 cm as equal and barely moves a ratio of errors of tenths of 
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 
 import numpy as np
 
 from ..estimators.centre_of_rotation.filter import CentreOfRotationParams, estimate_centre_of_rotation
 from ..papers.paper002 import truth_floor
 from ..sea.motion_model import stack
-from .defaults import CASES, DT, RATIO_GOAL, case_record, placements
+from .cases import CASES, DT, RATIO_GOAL, case_record, placements
 
 #: True CR relative to the COG, body frame [m] (paper 002's reproduction).
 CR = (3.0, 0.0, -1.5)
@@ -118,7 +117,7 @@ def print_cr(rows: list[dict]) -> dict:
     -------
     dict
         ``worst_ratio``, ``worst_above_m`` (the defaults' largest merit), ``over_ratio`` and
-        ``over_floor_goal`` (how many scored cases miss :data:`~marinefmu.bench.defaults.RATIO_GOAL`
+        ``over_floor_goal`` (how many scored cases miss :data:`~marinefmu.bench.cases.RATIO_GOAL`
         and :data:`FLOOR_GOAL`), ``scored`` (cases with rotation enough to score).
     """
     f3 = lambda v: "/".join(f"{x:+.2f}" for x in v)  # noqa: E731

@@ -1,21 +1,21 @@
 """Benchmark part ``defaults``, GnssAccFusion: the fusion at its defaults, given geometry only,
-against the best fixed setting the project knows, on the grid of :mod:`.defaults`.
+against the best fixed setting the project knows, on the grid of :mod:`.cases`.
 
 Given geometry only means the accelerometer's lever arm (the case's IMU placement,
-:func:`~.defaults.placements`) and VesselMotion's default antennas, which are
+:func:`~.cases.placements`) and VesselMotion's default antennas, which are
 GnssAccFusionParams' defaults (:data:`~marinefmu.estimators.gnss_fusion.antenna_attitude.DEFAULT_ANTENNAS`);
 the receiver is VesselMotion's default (5 Hz RTK, σ_h 1 cm, σ_v 1.5 cm per antenna).
 
 Each case: the real-time COG position RMS error per NED axis [cm] over
-``[SETTLE, FUSION_DURATION]`` (:data:`~.defaults.SETTLE`) at the defaults
+``[SETTLE, FUSION_DURATION]`` (:data:`~.cases.SETTLE`) at the defaults
 (``noise_sizing="auto"``) and with each setting of :data:`FUSION_GRID`
 (``noise_sizing="fixed"``). The figure of merit is the 3-D RMS, √(e_N² + e_E² + e_D²): the
 fusion outputs one position, q and r trade the axes against each other (``q_down`` moves the
 down axis only), and the largest axis would flip between axes from one setting to the next on
-differences of a millimetre. The goal: the defaults within :data:`~.defaults.RATIO_GOAL` of
+differences of a millimetre. The goal: the defaults within :data:`~.cases.RATIO_GOAL` of
 the grid's best on every case.
 
-The records are :data:`FUSION_DURATION` long, not the 600 s of :mod:`.defaults`: one fusion
+The records are :data:`FUSION_DURATION` long, not the 600 s of :mod:`.cases`: one fusion
 run over 600 s costs about a minute of one core, and the scored 150 s after the settling
 already hold 15-30 wave periods. Every run here, the defaults' too, sets ``coast="inertial"``
 (:data:`BENCH_COAST`): the records have no GNSS gap, and without one the wave coast never
@@ -31,7 +31,7 @@ import numpy as np
 from ..estimators.gnss_fusion.filter import GnssAccFusionParams
 from ..estimators.gnss_fusion.runs import fuse
 from ..sea.motion_model import stack
-from .defaults import CASES, DT, RATIO_GOAL, SETTLE, case_record, placements
+from .cases import CASES, DT, RATIO_GOAL, SETTLE, case_record, placements
 
 #: Record length of a fusion case [s] (module docstring).
 FUSION_DURATION = 300.0

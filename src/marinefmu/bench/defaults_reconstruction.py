@@ -1,9 +1,9 @@
 """Benchmark part ``defaults``, DisplacementReconstructor: its defaults, given geometry only,
-against the settings the project knows, on the grid of :mod:`marinefmu.bench.defaults`.
+against the settings the project knows, on the grid of :mod:`marinefmu.bench.cases`.
 
-Each case (:data:`~marinefmu.bench.defaults.CASES`: three vessel presets × three seas × two IMU
-placements) is a VesselMotion record of :data:`DURATION` s (:func:`~marinefmu.bench.defaults.case_record`)
-with the default MEMS IMU at :func:`~marinefmu.bench.defaults.placements`. The reconstructor is fed
+Each case (:data:`~marinefmu.bench.cases.CASES`: three vessel presets × three seas × two IMU
+placements) is a VesselMotion record of :data:`DURATION` s (:func:`~marinefmu.bench.cases.case_record`)
+with the default MEMS IMU at :func:`~marinefmu.bench.cases.placements`. The reconstructor is fed
 the IMU's specific force and the AttitudeEstimator's roll, pitch and yaw at its defaults (what a
 user who chains the two FMUs gets; the yaw is gyro-integrated and drifts slowly, which the
 reconstructor's COG transfer must bear), and is given only ``lever_arm`` = the IMU placement.
@@ -16,7 +16,7 @@ estimate against the true COG, each about its mean over the span (a reconstructi
 acceleration has no absolute position), in % of the true COG motion's standard deviation per
 NED axis. The figure of merit is the largest of the three axes: a user relies on every axis, and
 the horizontal axes, where the attitude error's g·ε acceleration lands, are the hard ones.
-The goal: the defaults within :data:`~marinefmu.bench.defaults.RATIO_GOAL` of the grid's best on
+The goal: the defaults within :data:`~marinefmu.bench.cases.RATIO_GOAL` of the grid's best on
 every case.
 
 :data:`DURATION` = 700 s: the default 200 s window fills at 200 s, the first output scored is
@@ -36,7 +36,7 @@ import numpy as np
 from ..estimators.attitude.estimator import AttitudeEstimatorParams, estimate_attitude
 from ..estimators.reconstruction.sliding import DisplacementReconstructor, DisplacementReconstructorParams
 from ..sea.motion_model import stack
-from .defaults import CASES, DT, RATIO_GOAL, SETTLE, case_record, placements
+from .cases import CASES, DT, RATIO_GOAL, SETTLE, case_record, placements
 
 DURATION = 700.0
 #: Settings the project knows: the paper-000 semi-submersible reproduction's 0.04 Hz screening,

@@ -91,7 +91,7 @@ def grid_cover() -> dict[str, dict]:
     from ..sea.hydro.validation import tail_bound
     from ..sea.vessel import bem_preset_path, load_rao_csv
     from ..sea.waves import SeaState
-    from .defaults import SEAS
+    from .cases import SEAS
 
     out: dict[str, dict] = {}
     for name in BEM_PRESETS:

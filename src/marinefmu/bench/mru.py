@@ -1,11 +1,11 @@
 """Benchmark part ``mru``: the MotionReferenceUnit at its defaults, given its monitoring points
 only, against VesselMotion's truth, beside the datasheets of commercial units.
 
-The grid is the ``defaults`` part's (:data:`~.defaults.CASES`: the three vessel presets × the
+The grid is the ``defaults`` part's (:data:`~.cases.CASES`: the three vessel presets × the
 three benchmark seas × the IMU at the COG and far from it), default MEMS IMU, one seed,
 :data:`DURATION` s, scored from the first sample the joint filter gives (``motion.joint``; at
 the defaults and 100 Hz after about 15 minutes) or, if it never does, from
-:data:`~.defaults.SETTLE` s or the first valid sample, whichever is later: the goals are the
+:data:`~.cases.SETTLE` s or the first valid sample, whichever is later: the goals are the
 unit's accuracy once settled, as a datasheet's. The monitoring points
 (:data:`~marinefmu.estimators.mru.goals.POINTS`, relative to the IMU, body frame) reach 59.8 m
 from the IMU.
@@ -29,7 +29,7 @@ from ..estimators.mru.unit import AXES, MotionReferenceUnit
 from ..frames import rot_nb
 from ..papers.motion_bound import causal_motion_bound
 from ..sea.motion_model import point_truth, stack
-from .defaults import CASES, DT, SETTLE, case_record, placements
+from .cases import CASES, DT, SETTLE, case_record, placements
 
 #: Length of each case's record [s]: the joint filter's first fit (two rows per weight, 640 s of
 #: taught rows at the defaults, after the axis filters' first delayed output at about 175 s) and
@@ -188,7 +188,7 @@ def filter_feed(gyro: np.ndarray, acc: np.ndarray, params: MotionReferenceUnitPa
 
 def fresh_filters(params: MotionReferenceUnitParams):
     """A fresh unit's motion filters (its :class:`~marinefmu.estimators.heave.wiener.WienerGroup`),
-    started at :data:`~.defaults.DT`."""
+    started at :data:`~.cases.DT`."""
     unit = MotionReferenceUnit(params, quiet=True)
     unit.start(DT)
     return unit.group
@@ -280,7 +280,7 @@ def print_heave_and_angles(rows: list[dict]) -> None:
 
 
 def mru_bench(progress: bool = True) -> dict:
-    """Every case of :data:`~.defaults.CASES`, two at a time (about 12 minutes on a 2-core
+    """Every case of :data:`~.cases.CASES`, two at a time (about 12 minutes on a 2-core
     machine, the causal bounds included), printed as a table, and the cost per step against its budget (the
     AttitudeEstimator's plus 1.5 × the HeaveObserver's)."""
     from concurrent.futures import ProcessPoolExecutor

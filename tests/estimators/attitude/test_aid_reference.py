@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from marinefmu.bench.defaults import case_record
+from marinefmu.bench.cases import case_record
 from marinefmu.estimators.attitude import estimator as att
 from marinefmu.estimators.attitude.estimator import AttitudeEstimator, AttitudeEstimatorParams
 from marinefmu.sea.motion_model import point_truth, stack

@@ -8,7 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from marinefmu.bench.defaults import attitude_rms_deg, case_record
+from marinefmu.bench.cases import case_record
+from marinefmu.bench.defaults import attitude_rms_deg
 from marinefmu.errors import ParameterError
 from marinefmu.estimators.attitude import estimator as att
 from marinefmu.estimators.attitude.estimator import AttitudeEstimator, AttitudeEstimatorParams

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from marinefmu.bench.defaults import attitude_rms_deg, case_record, point_heave_cm
+from marinefmu.bench.cases import case_record
+from marinefmu.bench.defaults import attitude_rms_deg, point_heave_cm
 from marinefmu.estimators.attitude.estimator import AttitudeEstimatorParams, estimate_attitude
 from marinefmu.sea.motion_model import stack
 

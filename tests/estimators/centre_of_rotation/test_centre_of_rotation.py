@@ -156,7 +156,7 @@ def test_auto_window_brings_a_far_imu_on_a_large_ship_near_the_floor():
     leaves the final estimate 6.0 m above the record's floor (the gyro noise in α pulls it to the
     sensor; docs/decisions/centre-of-rotation-defaults.md); the window sized from the data
     (3-4 s here) leaves 0.63 m. Limit 0.8 m."""
-    from marinefmu.bench.defaults import case_record, placements
+    from marinefmu.bench.cases import case_record, placements
     from marinefmu.bench.defaults_cr import CR, cr_errors
     sensor = placements("polar_supply")["far"]
     rec = case_record("polar_supply", 3.0, 10.0, "far",

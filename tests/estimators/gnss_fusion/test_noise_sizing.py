@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from marinefmu.bench.defaults import case_record, placements
+from marinefmu.bench.cases import case_record, placements
 from marinefmu.bench.defaults_fusion import FUSION_GRID, cog_rms_cm, merit
 from marinefmu.errors import ParameterError
 from marinefmu.estimators.gnss_fusion.antenna_attitude import DEFAULT_ANTENNAS, antenna_attitude

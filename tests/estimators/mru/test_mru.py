@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from marinefmu import MotionReferenceUnit, MotionReferenceUnitParams, ParameterError
-from marinefmu.bench.defaults import DT, case_record
+from marinefmu.bench.cases import DT, case_record
 from marinefmu.bench.mru import run_mru
 from marinefmu.estimators.attitude.estimator import AttitudeEstimatorParams
 from marinefmu.estimators.heave.common import HeaveObserverParams
