@@ -206,17 +206,18 @@ def replay_filters(fed: list[list[float | None]], params: MotionReferenceUnitPar
                    sizing: dict[int, tuple] | None = None) -> list[np.ndarray | None]:
     """The unit's motion filters, fresh, fed ``fed`` with the parameters ``sizing``
     (:func:`filter_feed`): their outputs."""
-    group = fresh_filters(params)
-    return [replay_step(group, fed, sizing or {}, k) for k in range(len(fed))]
+    group, sizing = fresh_filters(params), sizing or {}
+    return [replay_step(group, fed, sizing, k) for k in range(len(fed))]
 
 
 def cost_per_step(steps: int = 30000, warm: int = 100000) -> dict[str, float]:
     """In-process µs per step of the MotionReferenceUnit with the four monitoring points
-    (:data:`~marinefmu.estimators.mru.goals.POINTS`) and with none, the AttitudeEstimator and the HeaveObserver at their defaults, on the first case's
-    record: each model runs ``warm`` steps untimed (1000 s at 100 Hz: the joint filter taught,
-    every spectrum window at its longest) and then ``steps`` timed (best of two runs each, the
-    models taking turns; the design, refit and bias-step work amortised over the timed steps,
-    which span five designs per axis and two refits).
+    (:data:`~marinefmu.estimators.mru.goals.POINTS`) and with none, the AttitudeEstimator and
+    the HeaveObserver at their defaults, on the first case's record: each model runs ``warm``
+    steps untimed (1000 s at 100 Hz: the joint filter taught, every spectrum window at its
+    longest) and then ``steps`` timed (best of two runs each, the models taking turns; the
+    design, refit and bias-step work amortised over the timed steps, which span five designs
+    per axis and two refits).
 
     The budget is the AttitudeEstimator's plus 1.5 × the HeaveObserver's. The unit without
     points is what the budget compares: the attitude and the motion at the IMU (three axis
@@ -281,8 +282,8 @@ def print_heave_and_angles(rows: list[dict]) -> None:
 
 def mru_bench(progress: bool = True) -> dict:
     """Every case of :data:`~.cases.CASES`, two at a time (about 12 minutes on a 2-core
-    machine, the causal bounds included), printed as a table, and the cost per step against its budget (the
-    AttitudeEstimator's plus 1.5 × the HeaveObserver's)."""
+    machine, the causal bounds included), printed as a table, and the cost per step against its
+    budget (the AttitudeEstimator's plus 1.5 × the HeaveObserver's)."""
     from concurrent.futures import ProcessPoolExecutor
 
     from tqdm import tqdm

@@ -181,8 +181,8 @@ class GyroTilt:
             self.state = None
             return
         self.state = tuple(float(v) for v in s[:4])
-        self.last = (float(s[4]), float(s[5])) if len(s) > 4 else (0.0, 0.0)
-        self.gap = bool(s[6]) if len(s) > 6 else False
+        self.last = (float(s[4]), float(s[5]))
+        self.gap = bool(s[6])
 
 
 def yaw_rotation(yaw: float) -> np.ndarray:
