@@ -50,11 +50,11 @@ CASES: tuple[tuple[str, float, float, str], ...] = tuple(
 
 
 def case_record(preset: str, hs: float, tp: float, place: str, duration: float = DURATION,
-                extra: dict | None = None) -> dict[str, np.ndarray]:
-    """VesselMotion record of one case (:data:`SEED`, bow-quartering); ``extra``: more
-    VesselMotion parameters (e.g. ``{"imu.grade": "mru"}``)."""
+                extra: dict | None = None, dt: float = DT) -> dict[str, np.ndarray]:
+    """VesselMotion record of one case (:data:`SEED`, bow-quartering) at the step ``dt`` [s];
+    ``extra``: more VesselMotion parameters (e.g. ``{"imu.grade": "mru"}``)."""
     imu = placements(preset)[place]
     flat = {"sea.hs": hs, "sea.tp": tp, "sea.seed": SEED, "sea.heading": HEADING, "vessel.preset": preset,
             **{f"imu.{a}": v for a, v in zip("xyz", imu)},
             **{f"point.{a}": v for a, v in zip("xyz", monitoring_point(preset, place))}, **(extra or {})}
-    return simulate_record(VesselMotionParams.from_flat(flat), duration, DT)
+    return simulate_record(VesselMotionParams.from_flat(flat), duration, dt)

@@ -4,7 +4,7 @@ only, against VesselMotion's truth, beside the datasheets of commercial units.
 The grid is the ``defaults`` part's (:data:`~.cases.CASES`: the three vessel presets × the
 three benchmark seas × the IMU at the COG and far from it), default MEMS IMU, one seed,
 :data:`DURATION` s, scored from the first sample the joint filter gives (``motion.joint``; at
-the defaults and 100 Hz after about 15 minutes) or, if it never does, from
+the defaults and 100 Hz after about 14 minutes) or, if it never does, from
 :data:`~.cases.SETTLE` s or the first valid sample, whichever is later: the goals are the
 unit's accuracy once settled, as a datasheet's. The monitoring points
 (:data:`~marinefmu.estimators.mru.goals.POINTS`, relative to the IMU, body frame) reach 59.8 m
@@ -36,21 +36,66 @@ from .cases import CASES, DT, SETTLE, case_record, placements
 #: then 15 minutes scored.
 DURATION = 1800.0
 
-def run_mru(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams) -> dict[str, np.ndarray]:
-    """The MotionReferenceUnit over a VesselMotion record: (N, ·) arrays of every output."""
+def run_mru(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams, dt: float = DT,
+            timed: bool = False) -> dict[str, np.ndarray]:
+    """The MotionReferenceUnit over a VesselMotion record of step ``dt`` [s]: (N, ·) arrays of
+    every output; with ``timed``, also each step's wall time [s] (``step_s``)."""
+    import time
+
     mru = MotionReferenceUnit(params, quiet=True)
     gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
     n, rows = len(acc), len(params.points) + 1
     out = {"roll": np.empty(n), "pitch": np.empty(n), "position": np.empty((n, rows, 3)),
            "velocity": np.empty((n, rows, 3)), "delayed": np.empty((n, rows, 3)), "valid": np.empty(n, bool),
-           "delayed_valid": np.empty(n, bool), "joint": np.empty(n, bool)}
+           "delayed_valid": np.empty(n, bool), "joint": np.empty(n, bool), "step_s": np.zeros(n)}
+    clock = time.perf_counter if timed else (lambda: 0.0)
     for k in range(n):
-        r = mru.step(gyro[k], acc[k], DT)
+        t = clock()
+        r = mru.step(gyro[k], acc[k], dt)
+        out["step_s"][k] = clock() - t
         out["roll"][k], out["pitch"][k] = r.roll, r.pitch
         out["position"][k], out["velocity"][k], out["delayed"][k] = r.position, r.velocity, r.delayed_position
         out["valid"][k], out["delayed_valid"][k], out["joint"][k] = r.motion_valid, r.delayed_valid, r.joint
     out["delay"] = np.array(mru.delay)
     return out
+
+
+def scored_from(out: dict[str, np.ndarray], dt: float = DT) -> int:
+    """The first scored sample of a run (module docstring): the joint filter's first output, or
+    :data:`~.cases.SETTLE` s or the first valid sample, whichever is later."""
+    k0 = max(int(SETTLE / dt), int(np.argmax(out["valid"])))
+    if out["joint"].any():
+        k0 = max(k0, int(np.argmax(out["joint"])))
+    return k0
+
+
+def score_locations(rec: dict[str, np.ndarray], out: dict[str, np.ndarray], k0: int, dt: float = DT,
+                    bounds: list[list[float]] | None = None) -> list[dict]:
+    """Per location (the IMU, then :data:`~marinefmu.estimators.mru.goals.POINTS`) from sample
+    ``k0``: the real-time and delayed position errors and the velocity error (RMS about the
+    mean, cm and cm/s), the truth's std and the goals, with the heave goal's causal bound
+    ``bounds`` (:func:`case_bound`) if given."""
+    lag = int(round(float(out["delay"]) / dt))
+    rows = []
+    for j, arm in enumerate(((0.0, 0.0, 0.0), *POINTS)):
+        pos, vel = point_truth(rec, arm)
+        err = rms_about_mean(out["position"][k0:, j] - pos[k0:])
+        vel_err = rms_about_mean(out["velocity"][k0:, j] - vel[k0:])
+        delayed = rms_about_mean(out["delayed"][k0 + lag:, j] - pos[k0:len(pos) - lag])
+        std = np.std(pos[k0:], axis=0)
+        bound = None if bounds is None else bounds[j]
+        rows.append({"arm_m": arm, "distance_m": float(np.linalg.norm(arm)), "std_cm": (100 * std).tolist(),
+                     "rt_cm": (100 * err).tolist(), "delayed_cm": (100 * delayed).tolist(),
+                     "vel_cms": (100 * vel_err).tolist(), "vel_std_cms": (100 * np.std(vel[k0:], axis=0)).tolist(),
+                     "bound_cm": bound, "goal_cm": goals(100 * std, None if bound is None else np.array(bound)).tolist()})
+    return rows
+
+
+def angle_errors_deg(rec: dict[str, np.ndarray], out: dict[str, np.ndarray], k0: int) -> tuple[float, float]:
+    """RMS roll and pitch errors [deg] from sample ``k0`` (the roll's wrapped)."""
+    roll = np.degrees(np.sqrt(np.mean(np.angle(np.exp(1j * (out["roll"][k0:] - rec["truth.roll"][k0:]))) ** 2)))
+    pitch = np.degrees(np.sqrt(np.mean((out["pitch"][k0:] - rec["truth.pitch"][k0:]) ** 2)))
+    return float(roll), float(pitch)
 
 
 def true_attitude_cm(rec: dict[str, np.ndarray], params: MotionReferenceUnitParams, k0: int) -> list[float]:
@@ -100,32 +145,59 @@ def mru_case(preset: str, hs: float, tp: float, place: str, extra: dict | None =
     out = run_mru(rec, MotionReferenceUnitParams(points=POINTS))
     if not out["valid"].any():        # no sea above the noise the filters assume: no motion output
         return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "valid": False}
-    k0 = max(int(SETTLE / DT), int(np.argmax(out["valid"])))
-    if out["joint"].any():
-        k0 = max(k0, int(np.argmax(out["joint"])))
+    k0 = scored_from(out)
     axis = run_mru(rec, MotionReferenceUnitParams(motion_model="axis"))
     imu, _ = point_truth(rec, (0.0, 0.0, 0.0))
-    lag = int(round(float(out["delay"]) / DT))
-    bounds = case_bound(preset, hs, tp, place, extra)
-    rows = []
-    for j, arm in enumerate(((0.0, 0.0, 0.0), *POINTS)):
-        pos, vel = point_truth(rec, arm)
-        est = out["position"][k0:, j]
-        err = rms_about_mean(est - pos[k0:])
-        vel_err = rms_about_mean(out["velocity"][k0:, j] - vel[k0:])
-        delayed = rms_about_mean(out["delayed"][k0 + lag:, j] - pos[k0:len(pos) - lag])
-        std = np.std(pos[k0:], axis=0)
-        rows.append({"arm_m": arm, "distance_m": float(np.linalg.norm(arm)), "std_cm": (100 * std).tolist(),
-                     "rt_cm": (100 * err).tolist(), "delayed_cm": (100 * delayed).tolist(),
-                     "vel_cms": (100 * vel_err).tolist(), "vel_std_cms": (100 * np.std(vel[k0:], axis=0)).tolist(),
-                     "bound_cm": bounds[j], "goal_cm": goals(100 * std, np.array(bounds[j])).tolist()})
-    roll = np.degrees(np.sqrt(np.mean(np.angle(np.exp(1j * (out["roll"][k0:] - rec["truth.roll"][k0:]))) ** 2)))
-    pitch = np.degrees(np.sqrt(np.mean((out["pitch"][k0:] - rec["truth.pitch"][k0:]) ** 2)))
-    return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "valid": True, "roll_deg": float(roll),
-            "pitch_deg": float(pitch), "scored_from_s": k0 * DT, "joint": bool(out["joint"][k0:].all()),
+    rows = score_locations(rec, out, k0, bounds=case_bound(preset, hs, tp, place, extra))
+    roll, pitch = angle_errors_deg(rec, out, k0)
+    return {"preset": preset, "hs": hs, "tp": tp, "imu": place, "valid": True, "roll_deg": roll,
+            "pitch_deg": pitch, "scored_from_s": k0 * DT, "joint": bool(out["joint"][k0:].all()),
             "axis_imu_cm": (100 * rms_about_mean(axis["position"][k0:, 0] - imu[k0:])).tolist(),
             "delay_s": float(out["delay"]), "points": rows,
             "true_attitude_imu_cm": true_attitude_cm(rec, MotionReferenceUnitParams(points=POINTS), k0)}
+
+
+#: Sample rates [Hz] of the rate table (:func:`rate_case`): commercial units output at 10 to
+#: 200 Hz.
+RATES = (10.0, 20.0, 50.0, 100.0, 200.0)
+#: The rate table's case: polar_supply in Hs 3 m / Tp 10 s, the IMU at the COG.
+RATE_CASE = ("polar_supply", 3.0, 10.0, "cog")
+
+
+def rate_case(rate: float, duration: float = DURATION) -> dict:
+    """The unit at the defaults plus :data:`~marinefmu.estimators.mru.goals.POINTS` on
+    :data:`RATE_CASE`'s sea sampled at ``rate`` [Hz], scored as :func:`mru_case` (the goals
+    without the causal bound, which only raises the heave goal): roll and pitch [deg], every
+    location's errors (:func:`score_locations`), when ``motion_valid`` and ``joint`` first hold
+    [s], and the step's mean and worst wall time in-process [µs, ms] (the designs, the bias-step
+    searches and the refits included)."""
+    dt = 1.0 / rate
+    rec = case_record(*RATE_CASE, duration=duration, dt=dt)
+    out = run_mru(rec, MotionReferenceUnitParams(points=POINTS), dt, timed=True)
+    k0 = scored_from(out, dt)
+    roll, pitch = angle_errors_deg(rec, out, k0)
+    return {"rate_hz": rate, "roll_deg": roll, "pitch_deg": pitch, "scored_from_s": k0 * dt,
+            "valid_from_s": float(np.argmax(out["valid"]) + 1) * dt,
+            "joint_from_s": float(np.argmax(out["joint"]) + 1) * dt if out["joint"].any() else None,
+            "points": score_locations(rec, out, k0, dt),
+            "mean_step_us": 1e6 * float(np.mean(out["step_s"])), "worst_step_ms": 1e3 * float(np.max(out["step_s"]))}
+
+
+def print_rates(rows: list[dict]) -> None:
+    """The rate table: per rate, roll / pitch, the IMU's real-time and delayed errors, the
+    farthest point's real-time heave against its goal, when the motion and the joint filter
+    start, and the step's cost."""
+    print(f"MotionReferenceUnit at other sample rates ({' '.join(map(str, RATE_CASE))}), defaults and the four points")
+    print(f"{'Hz':>5} {'roll/pitch deg':>15} {'IMU rt cm':>17} {'IMU delayed cm':>17} {'59.8 m heave (goal)':>20} "
+          f"{'valid / joint s':>16} {'mean us':>8} {'worst ms':>9} {'over goal':>9}")
+    for r in rows:
+        imu, far = r["points"][0], max(r["points"], key=lambda p: p["distance_m"])
+        over = sum(int(np.sum(np.asarray(p["rt_cm"]) > np.asarray(p["goal_cm"]))) for p in r["points"])
+        joint = "never" if r["joint_from_s"] is None else f"{r['joint_from_s']:.0f}"
+        print(f"{r['rate_hz']:5g} {r['roll_deg']:7.4f}/{r['pitch_deg']:.4f} "
+              f"{'/'.join(f'{x:.2f}' for x in imu['rt_cm']):>17} {'/'.join(f'{x:.2f}' for x in imu['delayed_cm']):>17} "
+              f"{far['rt_cm'][2]:10.2f} ({far['goal_cm'][2]:.2f}) {r['valid_from_s']:7.0f} / {joint:<6} "
+              f"{r['mean_step_us']:8.0f} {r['worst_step_ms']:9.1f} {over:9d}")
 
 
 def print_mru(rows: list[dict]) -> dict:
@@ -282,8 +354,9 @@ def print_heave_and_angles(rows: list[dict]) -> None:
 
 def mru_bench(progress: bool = True) -> dict:
     """Every case of :data:`~.cases.CASES`, two at a time (about 12 minutes on a 2-core
-    machine, the causal bounds included), printed as a table, and the cost per step against its
-    budget (the AttitudeEstimator's plus 1.5 × the HeaveObserver's)."""
+    machine, the causal bounds included), printed as a table; the rate table (:data:`RATES`,
+    one at a time, so that their step times are the machine's own, about 3 minutes); and the
+    cost per step against its budget (the AttitudeEstimator's plus 1.5 × the HeaveObserver's)."""
     from concurrent.futures import ProcessPoolExecutor
 
     from tqdm import tqdm
@@ -297,19 +370,22 @@ def mru_bench(progress: bool = True) -> dict:
     summary = print_mru(rows)
     print("with imu.grade = mru (IMU at the COG): goals <= 0.01 deg roll and pitch, and the heave goal at every point")
     print_heave_and_angles(mru_rows)
+    rates = [rate_case(rate) for rate in tqdm(RATES, unit="rate", desc="mru rates", disable=not progress)]
+    print_rates(rates)
     cost = cost_per_step()
     print(f"cost per step in-process: MotionReferenceUnit (4 points) {cost['mru_us']:.1f} us, without points "
           f"{cost['mru_no_points_us']:.1f} us, axis filters alone {cost['mru_axis_us']:.1f} us (joint filter "
           f"{'taught' if cost['joint_taught'] else 'NOT taught'}); budget {cost['budget_us']:.1f} us = AttitudeEstimator "
           f"{cost['attitude_us']:.1f} + 1.5 x HeaveObserver {cost['heave_us']:.1f}; floor {cost['floor_us']:.1f} us "
           f"= the attitude + its three axis filters {cost['filters_us']:.1f}")
-    return {"cases": rows, **summary, "mru_grade": mru_rows, "cost": cost}
+    return {"cases": rows, **summary, "mru_grade": mru_rows, "rates": rates, "cost": cost}
 
 
 def markdown(data: dict) -> str:
     """The docs page's tables from this part's output (``bench.json``'s ``mru``): per case, the
     worst point's real-time / delayed error against the goal per axis, and the IMU's with the
-    true attitude; then the ``mru`` grade's angles and farthest-point heave."""
+    true attitude; then the ``mru`` grade's angles and farthest-point heave; then, if measured,
+    the rate table (:func:`rate_case`)."""
     lines = ["| vessel | Hs m | Tp s | IMU | roll / pitch ° | surge cm | sway cm | heave cm | IMU, axis filters cm "
              "| IMU, true attitude cm |",
              "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
@@ -334,4 +410,17 @@ def markdown(data: dict) -> str:
         far = max(r["points"], key=lambda p: p["distance_m"])
         lines.append(f"| {r['preset']} | {r['hs']:g} | {r['tp']:g} | {r['roll_deg']:.4f} / {r['pitch_deg']:.4f} | "
                      f"{far['rt_cm'][2]:.2f} ({far['goal_cm'][2]:.2f}) |")
+    if data.get("rates"):
+        lines += ["", "| rate Hz | roll / pitch ° | IMU real-time surge / sway / heave cm | IMU delayed cm | heave at "
+                  "59.8 m cm (goal) | locations × axes over the goal | `motion.joint` from s | mean / worst step |",
+                  "|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for r in data["rates"]:
+            imu, far = r["points"][0], max(r["points"], key=lambda p: p["distance_m"])
+            over = sum(int(np.sum(np.asarray(p["rt_cm"]) > np.asarray(p["goal_cm"]))) for p in r["points"])
+            joint = "never" if r["joint_from_s"] is None else f"{r['joint_from_s']:.0f}"
+            lines.append(f"| {r['rate_hz']:g} | {r['roll_deg']:.3f} / {r['pitch_deg']:.3f} | "
+                         f"{' / '.join(f'{x:.2f}' for x in imu['rt_cm'])} | "
+                         f"{' / '.join(f'{x:.2f}' for x in imu['delayed_cm'])} | {far['rt_cm'][2]:.2f} "
+                         f"({far['goal_cm'][2]:.2f}) | {over} of {3 * len(r['points'])} | {joint} | "
+                         f"{r['mean_step_us']:.0f} µs / {r['worst_step_ms']:.0f} ms |")
     return "\n".join(lines)

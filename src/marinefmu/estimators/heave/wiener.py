@@ -466,7 +466,8 @@ class WienerAxis:
         """JSON-serialisable state."""
         def arr(v: Any) -> Any:
             return None if v is None else np.asarray(v).tolist()
-        return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect, "spectrum_buf": arr(self.spectrum_buf),
+        return {"dt": self.dt, "k": self.k, "next_detect": self.next_detect,
+                "interval_steps": None if self.dt is None else self.interval_steps, "spectrum_buf": arr(self.spectrum_buf),
                 "sum_buf": arr(self.sum_buf), "total": self.total, "taps": arr(self.taps),
                 "mean": self.mean, "level": self.level, "step_at": self.step_at, "peak_period": self.peak_period,
                 "peaks": list(self.peaks), "no_sea": self.no_sea}
@@ -478,6 +479,8 @@ class WienerAxis:
             return
         self.start(float(s["dt"]))
         self.k, self.next_detect = int(s["k"]), int(s["next_detect"])
+        # the design interval its owner started it with (a unit spreads several axes' designs)
+        self.interval_steps = int(s.get("interval_steps") or self.interval_steps)
         self.spectrum_buf = np.array(s["spectrum_buf"], dtype=float)
         self.sum_buf = np.array(s["sum_buf"], dtype=float).reshape(self.block, 2 * self.slots)
         self.total = float(s["total"])

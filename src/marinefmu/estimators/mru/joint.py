@@ -52,6 +52,7 @@ import numpy as np
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
 
 from ...frames import G
+from ..numerics import one_blas_thread
 
 #: Longest block of the rows [s]: a wave of 5 s or more is a smooth curve over it.
 LONGEST_BLOCK = 2.0
@@ -219,7 +220,8 @@ class JointMotion:
             self.batch.append(self.features(self.lag))
             self.batch_targets.append(np.concatenate([outputs[:3, 2], outputs[:3, 3]]))
         if k % self.refit_steps < self.stride and self.batch:
-            self._refit()
+            with one_blas_thread():               # (F × F) products and a Cholesky, F ≈ 600: below
+                self._refit()                     # OpenBLAS's threads' pay-off (numerics.one_blas_thread)
 
     def _refit(self) -> None:
         """Fold the batch into N and M and solve for W (module docstring)."""

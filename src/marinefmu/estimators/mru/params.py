@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import ParameterError, check_choice, check_range, check_vector
+from ...errors import ParameterError, check_choice, check_finite, check_range, check_vector
 from ..attitude.estimator import AttitudeEstimatorParams
 from ..heave.common import HeaveObserverParams
 
@@ -26,6 +26,9 @@ HEADING_TAU = 30.0
 YAW_TAU = 30.0
 #: Time constant of the two cascaded first-order low-passes that give a lever arm's mean [s].
 ARM_TAU = 100.0
+#: Coarsest step [s] at which the unit's accuracy is measured (10 Hz; the MotionReferenceUnit
+#: docs page's sample rates): a coarser step runs, with a warning.
+COARSEST_MEASURED_STEP = 0.1
 #: The real-time motion's estimators (``motion_model``): the joint filter of all six channels
 #: taught by the axis filters' delayed outputs (:mod:`.joint`), or the axis filters alone
 #: (paper 003's observer generalised to three axes).
@@ -126,6 +129,19 @@ class MotionReferenceUnitParams:
                                  f"got {self.tilt_tau:g} s")
         if not isinstance(self.aid_reference, (bool, np.bool_)):
             raise ParameterError(f"aid_reference must be true or false, got {self.aid_reference!r}")
+
+    def check_step(self, dt: float) -> float:
+        """``dt`` [s] as a float if the unit can run at that step, else a ParameterError naming
+        it: finite, > 0 and below π/``motion.omega_max``, so that the Nyquist frequency π/Δt lies
+        above the filters' band (each design reads the measured spectrum up to ``omega_max``,
+        and a sampled record has none above Nyquist)."""
+        limit = math.pi / self.motion.omega_max
+        x = check_finite("dt", dt, "s")
+        if not 0.0 < x < limit:
+            raise ParameterError(f"dt = {dt!r} s is out of range: must be > 0 and below π/omega_max = {limit:.4g} s, "
+                                 f"so that the Nyquist frequency π/dt lies above omega_max = "
+                                 f"{self.motion.omega_max:g} rad/s, the top of the motion filters' band")
+        return x
 
 
 @dataclass(slots=True)

@@ -30,21 +30,23 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    sway and heave at the IMU and their rates come instead from one causal linear filter of all
    six IMU channels' past, fitted to the three axis filters' delayed outputs; the outputs move
    over to it in :data:`~.joint.BLEND` s. Its rows do not carry the attitude's tilt error and
-   read every channel, so in a sea where one wave train drives all six motions it errs 2-3 ×
-   less than the axis filters in surge and sway. ``motion_model = "axis"`` keeps the axis
+   read every channel, so in a sea where one wave train drives all six motions it errs several
+   times less than the axis filters in surge and sway (the MotionReferenceUnit docs page's
+   Accuracy section has the figures). ``motion_model = "axis"`` keeps the axis
    filters' real-time outputs (paper 003's observer per axis). The delayed outputs are the
    axis filters' either way.
 4. **Monitoring points**: each adds its lever arm's motion about its mean, R r − ⟨R r⟩ with
    R = Rz(ψ_w) Ry(θ) Rx(φ), its rate Ṙ r from the gyro (Ṙ = R [ω]× less the slow yaw's turn)
-   and its acceleration (:mod:`.level_frame`), the exact rigid-body transfer (paper 003 eqs. 10-11 generalised to three axes and a 3-D lever arm).
+   and its acceleration (:mod:`.level_frame`), the exact rigid-body transfer (paper 003
+   eqs. 10-11 generalised to three axes and a 3-D lever arm).
    ψ_w, the yaw's wave-frequency part, comes from a fourth Wiener filter, on the Euler yaw
    rate ψ̇ (its "rate" output: the filter estimates ż from z̈ = ψ̇ with z = ∫ψ), designed like
    the others from ψ̇'s spectrum with the gyro's noise and bias as the sensor's
    (:func:`yaw_filter_params`) and the rate below ``omega_min`` rejected. The gyro-integrated
    yaw less its slow part (as the level frame's ψ − ψ̄) would keep the z gyro's bias wander
-   over the low-pass's 30 s, about 0.13° on the default MEMS grade: on ``polar_supply`` in
-   Hs 3 m / Tp 10 s the sway 59 m forward of the IMU errs 11 cm with it, 4.2 cm with the
-   filter (the IMU's own sway errs 3.5 cm).
+   over the low-pass's 30 s, about 0.13° on the default MEMS grade, 13 cm of sway at a point
+   60 m forward of the IMU; the filter rejects the rate below ``omega_min``, where that wander
+   lies.
 5. **Heading** (optional): a valid heading input ψ_in turns the yaw output to north by a
    first-order correction, ψ_out = ψ + c, c ← c + (1 − e^{−Δt/τ}) wrap(ψ_in − ψ − c)
    (``heading_tau``; the first valid heading sets c). It does not enter the motion, which is
@@ -89,7 +91,7 @@ from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW
 from .joint import JointMotion, linear_channels
 from .level_frame import GyroTilt, SlowLowPass, acceleration_weights, level_rows, location_map, turn_rate_rows, unwrap
-from .params import ARM_TAU, YAW_TAU, MotionReferenceUnitParams, MruResult
+from .params import ARM_TAU, COARSEST_MEASURED_STEP, YAW_TAU, MotionReferenceUnitParams, MruResult
 
 log = logging.getLogger(__name__)
 
@@ -252,18 +254,25 @@ class MotionReferenceUnit:
         acc : array_like
             (3,) specific force [m/s², body].
         dt : float
-            Step [s] (> 0); a change restarts every filter, with a warning.
+            Step [s], in (0, π/``motion.omega_max``) (else ParameterError, the unit unchanged;
+            :meth:`MotionReferenceUnitParams.check_step`); a change restarts every filter,
+            with a warning, and a step above :data:`~.params.COARSEST_MEASURED_STEP` is warned
+            of.
         heading : float, optional
             True heading of the body x axis [rad, clockwise from north]; None for none.
         heading_valid : bool
             Whether ``heading`` holds a measurement.
         """
         restart = None
-        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
-            restart = f"step size changed from {self.dt} s to {dt} s; every filter restarted"
-            self.log.warning("mru: %s", restart)
-            self.reset()
-        if self.dt is None:
+        if self.dt is None or not abs(dt - self.dt) <= 1e-9 * self.dt:      # a NaN step too
+            dt = self.params.check_step(dt)           # refused before anything changes
+            if self.dt is not None:
+                restart = f"step size changed from {self.dt} s to {dt} s; every filter restarted"
+                self.log.warning("mru: %s", restart)
+                self.reset()
+            if dt > COARSEST_MEASURED_STEP:
+                self.log.warning("mru: step %g s is coarser than the %g s the unit's accuracy is measured at; "
+                                 "expect larger errors", dt, COARSEST_MEASURED_STEP)
             self.start(dt)
         att = self.attitude.step(gyro, acc, dt)
         good = att.valid and att.warning is None
