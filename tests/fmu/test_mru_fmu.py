@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from tests.conftest import DT, Driver
 
+from marinefmu import ParameterError
 from marinefmu.bench.cases import case_record
 from marinefmu.estimators.mru.unit import MotionReferenceUnit
 from marinefmu.fmu.tables import mru_params
@@ -81,3 +82,16 @@ def test_the_fmu_parameters_reach_the_unit():
     p = mru_params({"tilt_tau": 0.0, "aid_reference": False, "joint_memory": 90.0, "motion_model": "axis"})
     assert (p.tilt_tau, p.aid_reference, p.joint_memory, p.motion_model) == (0.0, False, 90.0, "axis")
     assert mru_params({"tilt_tau": 50.0}).tilt_tau == 50.0
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"mp3.enabled": True, "mp3.x": 300.0}, "mp3 must lie within 200 m"),
+    ({"mp2.enabled": True, "mp4.enabled": True, "mp4.z": math.nan}, "mp4[2] = nan is not finite"),
+    ({"delayed_lag": -1.0}, "delayed_lag = -1.0 is out of range"),
+])
+def test_a_refusal_names_the_fmus_own_parameter(values, message):
+    """A point is named by its own number, not by its place among the enabled ones (the unit
+    numbers those 1, 2, …), and the delay by the FMU's name for it, not the heave filter's."""
+    with pytest.raises(ParameterError) as refused:
+        mru_params(values)
+    assert str(refused.value).startswith(message)

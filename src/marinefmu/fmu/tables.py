@@ -19,7 +19,8 @@ from ..estimators.heave.band_bank import BAND_VARIANCES
 from ..estimators.heave.common import MODEL_CHOICES, TRANSFER_CHOICES, VERTICAL_CHOICES, HeaveObserverParams
 from ..estimators.heave.oscillator_bank import DISCRETISATIONS, MEASUREMENTS
 from ..estimators.gnss_fusion.antenna_attitude import ANTENNAS
-from ..estimators.mru.params import MAX_ARM, MAX_POINTS, MotionReferenceUnitParams
+from ..errors import ParameterError
+from ..estimators.mru.params import MAX_ARM, MAX_POINTS, MotionReferenceUnitParams, check_arm
 from ..estimators.gnss_fusion.filter import ATTITUDE_CHOICES as FUSION_ATTITUDE_CHOICES
 from ..estimators.gnss_fusion.filter import NOISE_SIZINGS as FUSION_NOISE_SIZINGS
 from ..estimators.gnss_fusion.filter import COAST_CHOICES, PROPAGATION_CHOICES, STEP_INPUT_CHOICES, GnssAccFusionParams
@@ -378,10 +379,17 @@ def mru_params(values: dict[str, Any]) -> MotionReferenceUnitParams:
     """MotionReferenceUnitParams from FMI-named values: the points enabled, in order, and the
     axes' filter parameters on the HeaveObserver's defaults."""
     v = resolve(MRU_PARAMETERS, values, "MotionReferenceUnit")
-    points = tuple((v[f"mp{i}.x"], v[f"mp{i}.y"], v[f"mp{i}.z"]) for i in range(1, MAX_POINTS + 1)
+    # each enabled point checked under its own FMI name: the model numbers the enabled ones 1, 2, …
+    points = tuple(check_arm(f"mp{i}", (v[f"mp{i}.x"], v[f"mp{i}.y"], v[f"mp{i}.z"])) for i in range(1, MAX_POINTS + 1)
                    if v[f"mp{i}.enabled"])
-    motion = replace(_MRU.motion, window=v["window"], window_max=v["window_max"], omega_min=v["omega_min"],
-                     omega_max=v["omega_max"], acc_noise=v["acc_noise"], smoother_lag=v["delayed_lag"])
+    try:
+        motion = replace(_MRU.motion, window=v["window"], window_max=v["window_max"], omega_min=v["omega_min"],
+                         omega_max=v["omega_max"], acc_noise=v["acc_noise"], smoother_lag=v["delayed_lag"])
+    except ParameterError as exc:       # the heave observer's name for what this FMU calls delayed_lag
+        message = str(exc)
+        if not message.startswith("smoother_lag"):
+            raise
+        raise ParameterError("delayed_lag" + message[len("smoother_lag"):]) from None
     attitude = replace(_MRU.attitude, aid_sizing=v["aid_sizing"], vel_sigma=v["vel_sigma"], pos_sigma=v["pos_sigma"],
                        aid_rate=v["aid_rate"])
     return MotionReferenceUnitParams(attitude=attitude, motion=motion, points=points, heading_tau=v["heading_tau"],

@@ -177,6 +177,24 @@ def test_a_bad_sample_holds_warns_and_recovers(short):
     assert seen == [(False, False, True)] * 3
 
 
+def test_the_outputs_are_zero_until_their_flags_first_hold(short):
+    """Before ``motion_valid`` every motion output is zero, and the delayed outputs stay zero
+    until ``delayed_valid`` (the filters have run through the time they refer to), at the IMU
+    and at the point; from then on they move."""
+    gyro, acc = stack(short, "imu.gyro"), stack(short, "imu.acc")
+    mru = MotionReferenceUnit(short_params(), quiet=True)
+    seen = {"motion": False, "delayed": False}
+    for k in range(len(acc)):
+        r = mru.step(gyro[k], acc[k], DT)
+        seen["motion"] |= r.motion_valid
+        seen["delayed"] |= r.delayed_valid
+        if not seen["motion"]:
+            assert not np.any(r.position) and not np.any(r.velocity) and not np.any(r.heave_acc)
+        if not seen["delayed"]:
+            assert not np.any(r.delayed_position), k
+    assert seen["delayed"] and np.all(np.abs(r.delayed_position[:, 2]) > 0.0)
+
+
 def test_a_heading_input_turns_the_yaw_to_north(short):
     """A heading 0.5 rad off the gyro-integrated yaw: after 3 τ of the aid the yaw output is
     within 0.05 rad of it (e^-3 of the offset), and roll, pitch and motion are unchanged."""

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -49,6 +50,17 @@ def default_motion() -> HeaveObserverParams:
     """The three axes' filter parameters: the HeaveObserver's defaults with the delayed lag
     :data:`DELAYED_LAG`."""
     return HeaveObserverParams(smoother_lag=DELAYED_LAG)
+
+
+def check_arm(name: str, arm: Any) -> tuple[float, float, float]:
+    """A monitoring point's lever arm from the IMU [m, body] as floats, if it is finite and
+    within :data:`MAX_ARM` of the IMU; else a ParameterError naming it ``name``."""
+    arm = check_vector(name, arm, unit="m")
+    distance = math.sqrt(sum(a * a for a in arm))
+    if distance > MAX_ARM:
+        raise ParameterError(f"{name} must lie within {MAX_ARM:g} m of the IMU, got {distance:.1f} m "
+                             f"({', '.join(f'{a:g}' for a in arm)})")
+    return arm
 
 
 @dataclass(frozen=True)
@@ -110,16 +122,7 @@ class MotionReferenceUnitParams:
                                  f"got {self.motion.model!r}")
         if len(self.points) > MAX_POINTS:
             raise ParameterError(f"points: at most {MAX_POINTS} monitoring points, got {len(self.points)}")
-        checked = []
-        for i, arm in enumerate(self.points):
-            name = f"mp{i + 1}"
-            arm = check_vector(name, arm, unit="m")
-            distance = math.sqrt(sum(a * a for a in arm))
-            if distance > MAX_ARM:
-                raise ParameterError(f"{name} must lie within {MAX_ARM:g} m of the IMU, got {distance:.1f} m "
-                                     f"({', '.join(f'{a:g}' for a in arm)})")
-            checked.append(arm)
-        object.__setattr__(self, "points", tuple(checked))
+        object.__setattr__(self, "points", tuple(check_arm(f"mp{i + 1}", arm) for i, arm in enumerate(self.points)))
         check_range("heading_tau", self.heading_tau, lo=1.0, hi=3600.0, unit="s")
         check_choice("motion_model", self.motion_model, MOTION_MODELS)
         check_range("joint_memory", self.joint_memory, lo=10.0, hi=300.0, unit="s")
@@ -166,7 +169,8 @@ class MruResult:
     heave_acc : numpy.ndarray
         (P + 1,) vertical acceleration [m/s², down], the bias estimate removed.
     delayed_position : numpy.ndarray
-        (P + 1, 3) surge, sway, heave ``delay`` s before this sample [m].
+        (P + 1, 3) surge, sway, heave ``delay`` s before this sample [m]; zeros until the
+        filters have run through that time (``delayed_valid`` first holds).
     delay : float
         Lag of the delayed outputs [s].
     wave_period : float

@@ -350,7 +350,8 @@ class MotionReferenceUnit:
             zeros, zero_acc = self.no_motion
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros, zero_acc, zeros, self.delay_s,
                              heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
-        delayed_valid = good and self.k * dt >= self.delayed_from
+        delayed_ready = self.k * dt >= self.delayed_from     # before it the delayed outputs are zeros
+        delayed_valid = good and delayed_ready
         joint = self.joint
         now = None                                 # the joint filter's (2, 3) position and rate, once taught
         if joint is not None:
@@ -369,7 +370,8 @@ class MotionReferenceUnit:
             else:
                 position, velocity = now[None, 0], now[None, 1]
             return MruResult(att.roll, att.pitch, yaw_out, position, velocity,
-                             np.array([self.heave_acc]), out[None, :3, 2], self.delay_s, heave_axis.peak_period,
+                             np.array([self.heave_acc]), out[None, :3, 2] if delayed_ready else self.no_motion[0],
+                             self.delay_s, heave_axis.peak_period,
                              angles_valid, good, delayed_valid, heading_used, warning, now is not None)
         w = self.weights.shape[1]
         j = (self.k - 1) % n                   # the newest sample's row
@@ -381,6 +383,8 @@ class MotionReferenceUnit:
             terms[3, :9] = 0.0
         terms[2, :9] = ring[(self.k - 1 - self.lag_steps) % n]
         terms[:3, 9:] = out[:3, :3].T
+        if not delayed_ready:
+            terms[2] = 0.0
         if now is not None:
             terms[:2, 9:] = now
         terms[3, 11] = self.heave_acc
