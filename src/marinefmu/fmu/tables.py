@@ -367,8 +367,8 @@ MRU_OUTPUTS: list[Variable] = [
 ]
 MRU_BOOLEANS: list[Variable] = [
     Variable("valid", "boolean", False, "", "roll, pitch, yaw: false while levelling and on a rejected (NaN/Inf/absurd) sample"),
-    Variable("motion.valid", "boolean", False, "", "The real-time motion: false until every axis's first spectrum and on a rejected sample"),
-    Variable("delayed.valid", "boolean", False, "", "The delayed outputs refer to a time the filters have run through"),
+    Variable("motion.valid", "boolean", False, "", "The real-time motion: false until every axis's first spectrum, on a rejected sample and for 120 x a run of them after it"),
+    Variable("delayed.valid", "boolean", False, "", "The delayed outputs refer to a time the filters have run through (and a run of rejected samples is 120 x its length and delayed_lag behind)"),
     Variable("heading.used", "boolean", False, "", "yaw is north-referenced"),
     Variable("motion.joint", "boolean", False, "", "The real-time motion is the joint filter's (taught), "
              "else the axis filters'"),

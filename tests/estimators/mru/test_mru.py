@@ -14,6 +14,7 @@ from marinefmu.bench.mru import rate_case, run_mru
 from marinefmu.estimators.attitude.estimator import AttitudeEstimatorParams
 from marinefmu.estimators.heave.common import HeaveObserverParams
 from marinefmu.estimators.mru.goals import rms_about_mean
+from marinefmu.estimators.mru.unit import RECOVERY
 from marinefmu.sea.motion_model import point_truth, stack
 
 ARMS = ((20.0, 5.0, -5.0), (59.0, 0.0, -10.0))
@@ -173,6 +174,8 @@ def test_a_bad_sample_holds_warns_and_recovers(short):
         if k in bad_at:
             seen.append((r.valid, r.motion_valid, r.warning is not None))
         elif k - 1 in bad_at:
+            assert r.valid and not r.motion_valid           # the angles at once, the motion after RECOVERY samples
+        elif k - 1 - RECOVERY in bad_at:
             assert r.valid and r.motion_valid
     assert seen == [(False, False, True)] * 3
 
@@ -490,6 +493,39 @@ def test_without_the_aid_reference_the_attitude_is_the_axis_units(high_sea):
     assert np.any(joint["roll"][k0:] != axis["roll"][k0:])
     with pytest.raises(ParameterError, match="aid_reference"):
         MotionReferenceUnitParams(aid_reference="yes")
+
+
+def test_after_a_gap_the_motion_is_invalid_until_the_filters_have_read_past_it(high_sea):
+    """A 0.5 s gap (NaN accelerations) with the joint filter running, in Hs 6 m:
+    ``motion_valid`` is false through it and for RECOVERY × 0.5 s = 60 s after,
+    ``delayed_valid`` for the delay more; once valid again, the IMU's real-time motion is
+    within its goals (with the joint filter's channels zeroed in the gap rather than held, it
+    erred 25-80 cm for that minute); and the attitude keeps the joint filter's aid reference
+    on every aid after the gap, while the filter's rows still hold it (dropping it there left
+    roll and pitch 5 × worse for the minute in Hs 3 m)."""
+    rec, _, _ = high_sea
+    gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
+    mru = MotionReferenceUnit(quiet=True)
+    k0, gap, span = 96000, 50, 9000
+    for k in range(k0):
+        mru.step(gyro[k], acc[k], DT)
+    hold = int(RECOVERY * gap)
+    flags, pos, referenced = [], [], []
+    for k in range(k0, k0 + span):
+        a = acc[k] if not k0 <= k < k0 + gap else np.full(3, np.nan)
+        r = mru.step(gyro[k], a, DT)
+        flags.append((r.motion_valid, r.delayed_valid))
+        pos.append(r.position[0])
+        referenced.append(mru.attitude.aid_reference is not None)
+    motion, delayed = np.array(flags).T
+    back = gap + hold
+    assert not motion[:back].any() and motion[back:].all()
+    assert not delayed[:back + mru.lag_steps].any() and delayed[back + mru.lag_steps:].all()
+    truth, _ = point_truth(rec, (0.0, 0.0, 0.0))
+    rt = 100 * rms_about_mean(np.array(pos)[back:] - truth[k0 + back:k0 + span])
+    std = 100 * np.std(truth[k0:k0 + span], axis=0)
+    assert np.all(rt <= np.maximum(2.0, np.array([0.05, 0.05, 0.025]) * std)), (rt, std)
+    assert all(referenced[gap + int(1.0 / DT):])         # from the first aid after the gap on
 
 
 def test_a_state_restored_while_the_joint_filter_runs_continues_bit_identically(high_sea):

@@ -144,6 +144,7 @@ class JointMotion:
         self.totals = (0.0,) * CHANNELS            # the channels' running sums
         self.angles = (0.0, 0.0, 0.0)              # the Euler rates' integral [rad]
         self.last_rates: tuple[float, float, float] | None = None
+        self.last_channels: tuple[float, ...] = (0.0,) * 6     # the last good sample's
         self.last_bad = -1 << 40                  # the newest step with a bad sample
         self.batch: list[np.ndarray] = []
         self.batch_targets: list[np.ndarray] = []
@@ -168,10 +169,14 @@ class JointMotion:
 
     def push(self, channels: tuple[float, ...] | None) -> None:
         """One sample of the six linear channels (:func:`linear_channels`), or None for a bad
-        sample (the rates and forces enter as zero and no row spanning it is taught)."""
+        sample: the last good one is held (as the attitude coasts on it), so that the angles'
+        integral runs on rather than stopping, which would offset every later row spanning the
+        gap by the angle turned in it (a 0.5 s gap in Hs 6 m: decimetres for the memory); no row
+        spanning it is taught."""
         if channels is None:
             self.last_bad = self.k
-            channels = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+            channels = self.last_channels
+        self.last_channels = channels
         u0, u1, u2, f0, f1, f2 = channels
         l0, l1, l2 = self.last_rates or (u0, u1, u2)
         self.last_rates = (u0, u1, u2)
@@ -264,10 +269,6 @@ class JointMotion:
         v[1, :3] += angle_sum
         self.node_weights = np.ascontiguousarray(np.column_stack([v.reshape(-1, TARGETS).T, self.weights[-1]]))
 
-    def clean(self) -> bool:
-        """Whether the newest row's span (the memory) holds no bad sample."""
-        return self.k - 1 - self.last_bad > self.edges[-1]
-
     def share(self) -> float:
         """Weight of the joint filter in the unit's outputs, 0 … 1: 0 until the first fit, then
         rising linearly to 1 over :data:`BLEND` s (``blended`` from then on)."""
@@ -290,6 +291,7 @@ class JointMotion:
         """JSON-serialisable state."""
         return {"k": self.k, "ring": self.ring.tolist(), "totals": list(self.totals), "angles": list(self.angles),
                 "last_rates": None if self.last_rates is None else list(self.last_rates),
+                "last_channels": list(self.last_channels),
                 "last_bad": self.last_bad, "batch": np.array(self.batch).tolist(),
                 "batch_targets": np.array(self.batch_targets).tolist(), "normal": self.normal.tolist(),
                 "moment": self.moment.tolist(), "rows": self.rows, "taught": self.taught, "fitted_at": self.fitted_at,
@@ -307,6 +309,7 @@ class JointMotion:
         self.totals = tuple(float(v) for v in s["totals"])
         self.angles = tuple(float(v) for v in s["angles"])
         self.last_rates = None if s["last_rates"] is None else tuple(float(v) for v in s["last_rates"])
+        self.last_channels = tuple(float(v) for v in s.get("last_channels", self.last_channels))
         self.batch = list(np.array(s["batch"], dtype=float).reshape(-1, self.features_count))
         self.batch_targets = list(np.array(s["batch_targets"], dtype=float).reshape(-1, TARGETS))
         self.normal = np.array(s["normal"], dtype=float)

@@ -179,9 +179,11 @@ class MruResult:
         Roll, pitch and yaw: levelled, the IMU sample good and the heading sample, if one is
         given, good.
     motion_valid : bool
-        The real-time motion: every axis's filter designed and the sample good.
+        The real-time motion: every axis's filter designed, the sample good and the last run of
+        bad samples, if any, :data:`~.unit.RECOVERY` × its length behind.
     delayed_valid : bool
-        The delayed outputs refer to a time the filters have run through.
+        The delayed outputs refer to a time the filters have run through, and the last run of
+        bad samples is that and the delay behind.
     heading_used : bool
         The yaw output is north-referenced (a valid heading has been received).
     warning : str or None

@@ -4,9 +4,11 @@ Per sample (:meth:`MotionReferenceUnit.step`):
 
 1. **Attitude**: the AttitudeEstimator at its parameters (paper 000 eqs. 6-9 with the aided
    tilt correction; :mod:`marinefmu.estimators.attitude.estimator`) gives R_nb, roll, pitch and
-   the gyro-integrated yaw ψ. Once the joint filter (step 3) has taken over, and while its
-   rows hold no bad sample, its horizontal position and velocity at the IMU are the
-   attitude's aid reference (the estimator's "aid reference"; ``aid_reference``, on by
+   the gyro-integrated yaw ψ. Once the joint filter (step 3) has taken over, its horizontal
+   position and velocity at the IMU are the attitude's aid reference on every good sample,
+   also while its rows still hold a bad one (a gap's zeros there move the reference by
+   centimetres; without it the aid falls back to its own sizing, and one bad sample left roll
+   and pitch 5 × worse for the joint filter's memory, 60 s) (the estimator's "aid reference"; ``aid_reference``, on by
    default): the aid then tells the tilt's slow drift from the waves to centimetres rather than
    metres per second, and roll and pitch err 2-3 × less in waves. It is computed only on the
    steps before the attitude's aid updates (``AttitudeEstimator.aid_due``), which alone read it.
@@ -71,7 +73,9 @@ Bad samples (NaN, Inf, absurd; the AttitudeEstimator's checks): the attitude coa
 good sample, each axis takes the window's mean acceleration (its estimate decays rather than
 drifts), the points keep the last good attitude, the gyro's tilt keeps its last difference from
 the attitude (:meth:`~.level_frame.GyroTilt.hold`), ``valid`` and ``motion_valid`` are false and
-the step's ``warning`` says why (also logged). A bad heading sample (while ``heading_valid``)
+the step's ``warning`` says why (also logged). The filters read the gap's stand-in samples for
+a while after it: ``motion_valid`` stays false for :data:`RECOVERY` × the gap's length after
+it, and ``delayed_valid`` for that plus the delay. A bad heading sample (while ``heading_valid``)
 is not used: the yaw's correction coasts and ``valid`` is false for that step. While the attitude levels (the first
 ``attitude.level_time`` s) the axes take no acceleration either: the tilt is not yet known.
 """
@@ -99,6 +103,12 @@ log = logging.getLogger(__name__)
 #: interval after the previous filter), so that the four cost one HeaveObserver's designs: the window they read grows to 20 minutes, and over one minute the
 #: design barely moves.
 DESIGN_ROUNDS = 4
+#: After a run of bad samples the motion stays invalid for RECOVERY × its length: the filters
+#: read the gap's stand-ins (the window's mean acceleration, the joint filter's held sample)
+#: until it has left their memory, and the attitude, which coasted through it on its last good
+#: gyro sample, needs its aid to come back; the error they leave grows with the gap's length
+#: (docs/decisions/mru-design.md has the measurements behind the factor).
+RECOVERY = 120.0
 #: The level frame's axes, in the order of the outputs' columns.
 AXES = ("surge", "sway", "heave")
 #: The identity's entries row by row.
@@ -207,6 +217,8 @@ class MotionReferenceUnit:
         self.psi_bar = 0.0                            # ψ̄, the level frame's reference yaw [rad]
         self.gyro_tilt = GyroTilt(p.tilt_tau) if p.tilt_tau > 0.0 else None
         self.next_sizing = 0                          # the sample count of the next surge or sway design
+        self.gap_steps = 0                            # bad samples in the current run of them
+        self.recovered_at = 0                         # the sample count from which the motion is valid again
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -276,6 +288,11 @@ class MotionReferenceUnit:
             self.start(dt)
         att = self.attitude.step(gyro, acc, dt)
         good = att.valid and att.warning is None
+        if att.warning is not None:                    # a bad sample: the motion recovers after the gap
+            self.gap_steps += 1
+            self.recovered_at = self.k + 2 + int(math.ceil(RECOVERY * self.gap_steps))   # a count: k + 1 after this
+        elif self.gap_steps:
+            self.gap_steps = 0
         points = len(self.arms)
         values: list[float | None]
         channels = None                                # the joint filter's sample (None: a bad one)
@@ -351,7 +368,8 @@ class MotionReferenceUnit:
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros, zero_acc, zeros, self.delay_s,
                              heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
         delayed_ready = self.k * dt >= self.delayed_from     # before it the delayed outputs are zeros
-        delayed_valid = good and delayed_ready
+        motion_valid = good and self.k >= self.recovered_at
+        delayed_valid = motion_valid and delayed_ready and self.k >= self.recovered_at + self.lag_steps
         joint = self.joint
         now = None                                 # the joint filter's (2, 3) position and rate, once taught
         if joint is not None:
@@ -363,7 +381,7 @@ class MotionReferenceUnit:
                         now = share * now + (1.0 - share) * out[:3, :2].T
                 if joint.blended and self.params.aid_reference and self.attitude.aid_due(dt):
                     # the attitude reads it at its next aid only
-                    self.attitude.aid_reference = self._aid_reference(now) if good and joint.clean() else None
+                    self.attitude.aid_reference = self._aid_reference(now) if good else None
         if not points:                             # the IMU's row only: views of this step's own outputs
             if now is None:
                 position, velocity = out[None, :3, 0], out[None, :3, 1]
@@ -372,7 +390,7 @@ class MotionReferenceUnit:
             return MruResult(att.roll, att.pitch, yaw_out, position, velocity,
                              np.array([self.heave_acc]), out[None, :3, 2] if delayed_ready else self.no_motion[0],
                              self.delay_s, heave_axis.peak_period,
-                             angles_valid, good, delayed_valid, heading_used, warning, now is not None)
+                             angles_valid, motion_valid, delayed_valid, heading_used, warning, now is not None)
         w = self.weights.shape[1]
         j = (self.k - 1) % n                   # the newest sample's row
         terms = self.terms
@@ -391,7 +409,7 @@ class MotionReferenceUnit:
         at = terms @ self.point_map            # (4, 3(P + 1)): every location's d + the IMU's motion
         motion = at[:3].reshape(3, points + 1, 3)
         return MruResult(att.roll, att.pitch, yaw_out, motion[0], motion[1], at[3, 2::3], motion[2], self.delay_s,
-                         heave_axis.peak_period, angles_valid, good, delayed_valid, heading_used, warning,
+                         heave_axis.peak_period, angles_valid, motion_valid, delayed_valid, heading_used, warning,
                          now is not None)
 
     def _size_tilt_noise(self) -> None:
@@ -443,7 +461,8 @@ class MotionReferenceUnit:
                 "turn_mean": self.turn_mean.get_state(), "yaw": self.yaw, "heading_offset": self.heading_offset,
                 "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist(),
                 "joint": None if self.joint is None else self.joint.get_state(), "psi_bar": self.psi_bar,
-                "gyro_tilt": None if self.gyro_tilt is None else self.gyro_tilt.get_state()}
+                "gyro_tilt": None if self.gyro_tilt is None else self.gyro_tilt.get_state(),
+                "gap_steps": self.gap_steps, "recovered_at": self.recovered_at}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -467,3 +486,4 @@ class MotionReferenceUnit:
         self.psi_bar = float(s.get("psi_bar", 0.0))
         if self.gyro_tilt is not None:
             self.gyro_tilt.set_state(s.get("gyro_tilt"))
+        self.gap_steps, self.recovered_at = int(s.get("gap_steps", 0)), int(s.get("recovered_at", 0))
