@@ -235,13 +235,10 @@ def test_a_step_size_change_restarts_with_a_warning(short):
     assert "step size changed" in r.warning and not r.valid and mru.k == 1
 
 
-@pytest.mark.parametrize("dt, says", [(0.0, "> 0"), (-0.01, "> 0"), (math.nan, "finite"), (math.inf, "finite"),
-                                      (0.6, "omega_max = 6 rad/s")])
-def test_a_step_it_cannot_run_at_is_refused_naming_it_and_nothing_changes(short, dt, says):
-    """A step that is not a finite number in (0, π/omega_max) (0.524 s at the defaults: above
-    it the Nyquist frequency lies inside the filters' band) is refused, first or mid-run, with
-    a message naming ``dt`` and its range; the unit is left as it was and continues
-    bit-identically."""
+@pytest.mark.parametrize("dt, says", [(0.0, "> 0"), (-0.01, "> 0"), (math.nan, "finite"), (math.inf, "finite")])
+def test_a_step_that_is_no_step_is_refused_naming_it_and_nothing_changes(short, dt, says):
+    """A step that is not a finite number > 0 is refused, first or mid-run, with a message
+    naming ``dt`` and its range; the unit is left as it was and continues bit-identically."""
     gyro, acc = stack(short, "imu.gyro"), stack(short, "imu.acc")
     with pytest.raises(ParameterError, match="dt") as refused:
         MotionReferenceUnit(short_params(), quiet=True).step(gyro[0], acc[0], dt)
@@ -255,6 +252,18 @@ def test_a_step_it_cannot_run_at_is_refused_naming_it_and_nothing_changes(short,
     assert mru.k == 200 and mru.dt == DT
     a, b = mru.step(gyro[200], acc[200], DT), twin.step(gyro[200], acc[200], DT)
     assert a.roll == b.roll and a.warning is None
+
+
+def test_at_a_step_whose_nyquist_is_inside_the_band_only_the_angles_are_given(caplog):
+    """0.6 s: π/0.6 = 5.2 rad/s, below omega_max = 6 rad/s. The unit runs (an FMI host may use
+    any step) and says why in the log; the angles level and are valid, the motion never is."""
+    mru = MotionReferenceUnit(MotionReferenceUnitParams(motion=HeaveObserverParams(window=45.0, omega_min=0.3)))
+    with caplog.at_level("WARNING", logger="marinefmu.estimators.mru.unit"):
+        for _ in range(200):                                 # 120 s, past the window
+            r = mru.step((0.01, 0.0, 0.0), (0.0, 0.0, -9.80665), 0.6)
+    assert [rec for rec in caplog.records if "Nyquist" in rec.getMessage()]
+    assert r.valid and not r.motion_valid and not r.delayed_valid
+    assert MotionReferenceUnitParams().longest_step == pytest.approx(math.pi / 6.0)
 
 
 def test_a_step_coarser_than_measured_runs_with_a_warning(short, caplog):

@@ -134,17 +134,20 @@ class MotionReferenceUnitParams:
             raise ParameterError(f"aid_reference must be true or false, got {self.aid_reference!r}")
 
     def check_step(self, dt: float) -> float:
-        """``dt`` [s] as a float if the unit can run at that step, else a ParameterError naming
-        it: finite, > 0 and below π/``motion.omega_max``, so that the Nyquist frequency π/Δt lies
-        above the filters' band (each design reads the measured spectrum up to ``omega_max``,
-        and a sampled record has none above Nyquist)."""
-        limit = math.pi / self.motion.omega_max
+        """``dt`` [s] as a float if it is a step at all, else a ParameterError naming it: finite
+        and > 0."""
         x = check_finite("dt", dt, "s")
-        if not 0.0 < x < limit:
-            raise ParameterError(f"dt = {dt!r} s is out of range: must be > 0 and below π/omega_max = {limit:.4g} s, "
-                                 f"so that the Nyquist frequency π/dt lies above omega_max = "
-                                 f"{self.motion.omega_max:g} rad/s, the top of the motion filters' band")
+        if not x > 0.0:
+            raise ParameterError(f"dt = {dt!r} s is out of range: must be > 0 [s]")
         return x
+
+    @property
+    def longest_step(self) -> float:
+        """π/``motion.omega_max`` [s]: at a step this long or longer the Nyquist frequency π/Δt
+        is at or below the filters' band, whose designs read the measured spectrum up to
+        ``omega_max`` (a sampled record has none above Nyquist); the unit then gives the angles
+        but not the motion."""
+        return math.pi / self.motion.omega_max
 
 
 @dataclass(slots=True)

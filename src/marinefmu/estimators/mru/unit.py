@@ -266,10 +266,12 @@ class MotionReferenceUnit:
         acc : array_like
             (3,) specific force [m/s², body].
         dt : float
-            Step [s], in (0, π/``motion.omega_max``) (else ParameterError, the unit unchanged;
-            :meth:`MotionReferenceUnitParams.check_step`); a change restarts every filter,
-            with a warning, and a step above :data:`~.params.COARSEST_MEASURED_STEP` is warned
-            of.
+            Step [s], finite and > 0 (else ParameterError, the unit unchanged); a change
+            restarts every filter, with a warning. A step above
+            :data:`~.params.COARSEST_MEASURED_STEP` is warned of; one of
+            ``params.longest_step`` (π/``motion.omega_max``) or more, where the filters' band
+            is not sampled, gives the angles only: ``motion_valid`` stays false, with a
+            warning.
         heading : float, optional
             True heading of the body x axis [rad, clockwise from north]; None for none.
         heading_valid : bool
@@ -282,10 +284,16 @@ class MotionReferenceUnit:
                 restart = f"step size changed from {self.dt} s to {dt} s; every filter restarted"
                 self.log.warning("mru: %s", restart)
                 self.reset()
-            if dt > COARSEST_MEASURED_STEP:
+            self.start(dt)
+            if dt >= self.params.longest_step:        # the band is not sampled: no motion
+                self.recovered_at = 1 << 62
+                self.log.warning("mru: step %g s: the Nyquist frequency pi/dt is below omega_max = %g rad/s, the top "
+                                 "of the motion filters' band; the motion is not estimated (motion.valid false); "
+                                 "a step below %.4g s gives it", dt, self.params.motion.omega_max,
+                                 self.params.longest_step)
+            elif dt > COARSEST_MEASURED_STEP:
                 self.log.warning("mru: step %g s is coarser than the %g s the unit's accuracy is measured at; "
                                  "expect larger errors", dt, COARSEST_MEASURED_STEP)
-            self.start(dt)
         att = self.attitude.step(gyro, acc, dt)
         good = att.valid and att.warning is None
         if att.warning is not None:                    # a bad sample: the motion recovers after the gap
