@@ -254,15 +254,20 @@ def test_a_step_that_is_no_step_is_refused_naming_it_and_nothing_changes(short, 
     assert a.roll == b.roll and a.warning is None
 
 
-def test_at_a_step_whose_nyquist_is_inside_the_band_only_the_angles_are_given(caplog):
+@pytest.mark.parametrize("dt, motion", [(0.5, True), (0.6, False)])
+def test_at_a_step_whose_nyquist_is_inside_the_band_only_the_angles_are_given(dt, motion, caplog):
     """0.6 s: π/0.6 = 5.2 rad/s, below omega_max = 6 rad/s. The unit runs (an FMI host may use
-    any step) and says why in the log; the angles level and are valid, the motion never is."""
-    mru = MotionReferenceUnit(MotionReferenceUnitParams(motion=HeaveObserverParams(window=45.0, omega_min=0.3)))
+    any step) and says why in the log; the angles level and are valid, the motion never is,
+    also after a gap. At 0.5 s (π/0.5 = 6.3 rad/s) the same sea gives the motion."""
+    rec = case_record("polar_supply", 3.0, 10.0, "cog", duration=400.0, dt=dt)
+    gyro, acc = stack(rec, "imu.gyro"), stack(rec, "imu.acc")
+    acc[len(acc) // 2] = np.nan                                # a gap half way
+    mru = MotionReferenceUnit(short_params())
     with caplog.at_level("WARNING", logger="marinefmu.estimators.mru.unit"):
-        for _ in range(200):                                 # 120 s, past the window
-            r = mru.step((0.01, 0.0, 0.0), (0.0, 0.0, -9.80665), 0.6)
-    assert [rec for rec in caplog.records if "Nyquist" in rec.getMessage()]
-    assert r.valid and not r.motion_valid and not r.delayed_valid
+        flags = [mru.step(gyro[k], acc[k], dt) for k in range(len(acc))]
+    assert bool([rec for rec in caplog.records if "Nyquist" in rec.getMessage()]) is not motion
+    assert flags[-1].valid and any(r.motion_valid for r in flags) is motion
+    assert (flags[-1].motion_valid and flags[-1].delayed_valid) is motion
     assert MotionReferenceUnitParams().longest_step == pytest.approx(math.pi / 6.0)
 
 

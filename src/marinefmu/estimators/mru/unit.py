@@ -5,13 +5,14 @@ Per sample (:meth:`MotionReferenceUnit.step`):
 1. **Attitude**: the AttitudeEstimator at its parameters (paper 000 eqs. 6-9 with the aided
    tilt correction; :mod:`marinefmu.estimators.attitude.estimator`) gives R_nb, roll, pitch and
    the gyro-integrated yaw ψ. Once the joint filter (step 3) has taken over, its horizontal
-   position and velocity at the IMU are the attitude's aid reference on every good sample,
-   also while its rows still hold a bad one (a gap's zeros there move the reference by
-   centimetres; without it the aid falls back to its own sizing, and one bad sample left roll
-   and pitch 5 × worse for the joint filter's memory, 60 s) (the estimator's "aid reference"; ``aid_reference``, on by
-   default): the aid then tells the tilt's slow drift from the waves to centimetres rather than
-   metres per second, and roll and pitch err 2-3 × less in waves. It is computed only on the
-   steps before the attitude's aid updates (``AttitudeEstimator.aid_due``), which alone read it.
+   position and velocity at the IMU are the attitude's aid reference (the estimator's "aid
+   reference"; ``aid_reference``, on by default): the aid then tells the tilt's slow drift from
+   the waves to centimetres rather than metres per second, and roll and pitch err 2-3 × less
+   in waves. It is set on every good sample, also while the joint filter's rows still hold a
+   bad one (the gap moves the reference by centimetres; without it the aid falls back to its
+   own sizing, which left roll and pitch 5 × worse for the joint filter's memory after a
+   single bad sample), and computed only on the steps before the attitude's aid updates
+   (``AttitudeEstimator.aid_due``), which alone read it.
 2. **Level frame** (:mod:`.level_frame`): R_hb = Rz(−ψ̄) R_nb, with ψ̄ the slow part of ψ, and
    the IMU's acceleration there, a_h = R_hb f_b + [0, 0, g] (the horizontal specific force after
    tilt compensation). The horizontal axes take it turned by a tilt whose wave-frequency part
@@ -298,7 +299,8 @@ class MotionReferenceUnit:
         good = att.valid and att.warning is None
         if att.warning is not None:                    # a bad sample: the motion recovers after the gap
             self.gap_steps += 1
-            self.recovered_at = self.k + 2 + int(math.ceil(RECOVERY * self.gap_steps))   # a count: k + 1 after this
+            # a count (k + 1 after this sample); never earlier than set (a step that leaves the band unsampled)
+            self.recovered_at = max(self.recovered_at, self.k + 2 + int(math.ceil(RECOVERY * self.gap_steps)))
         elif self.gap_steps:
             self.gap_steps = 0
         points = len(self.arms)
