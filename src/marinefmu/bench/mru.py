@@ -183,6 +183,14 @@ def rate_case(rate: float, duration: float = DURATION) -> dict:
             "mean_step_us": 1e6 * float(np.mean(out["step_s"])), "worst_step_ms": 1e3 * float(np.max(out["step_s"]))}
 
 
+def rate_summary(r: dict) -> tuple[dict, dict, int, str]:
+    """Of one :func:`rate_case`: the IMU's and the farthest point's rows, how many location ×
+    axis errors are over their goals, and when the joint filter took over [s] as text."""
+    imu, far = r["points"][0], max(r["points"], key=lambda p: p["distance_m"])
+    over = sum(int(np.sum(np.asarray(p["rt_cm"]) > np.asarray(p["goal_cm"]))) for p in r["points"])
+    return imu, far, over, "never" if r["joint_from_s"] is None else f"{r['joint_from_s']:.0f}"
+
+
 def print_rates(rows: list[dict]) -> None:
     """The rate table: per rate, roll / pitch, the IMU's real-time and delayed errors, the
     farthest point's real-time heave against its goal, when the motion and the joint filter
@@ -191,9 +199,7 @@ def print_rates(rows: list[dict]) -> None:
     print(f"{'Hz':>5} {'roll/pitch deg':>15} {'IMU rt cm':>17} {'IMU delayed cm':>17} {'59.8 m heave (goal)':>20} "
           f"{'valid / joint s':>16} {'mean us':>8} {'worst ms':>9} {'over goal':>9}")
     for r in rows:
-        imu, far = r["points"][0], max(r["points"], key=lambda p: p["distance_m"])
-        over = sum(int(np.sum(np.asarray(p["rt_cm"]) > np.asarray(p["goal_cm"]))) for p in r["points"])
-        joint = "never" if r["joint_from_s"] is None else f"{r['joint_from_s']:.0f}"
+        imu, far, over, joint = rate_summary(r)
         print(f"{r['rate_hz']:5g} {r['roll_deg']:7.4f}/{r['pitch_deg']:.4f} "
               f"{'/'.join(f'{x:.2f}' for x in imu['rt_cm']):>17} {'/'.join(f'{x:.2f}' for x in imu['delayed_cm']):>17} "
               f"{far['rt_cm'][2]:10.2f} ({far['goal_cm'][2]:.2f}) {r['valid_from_s']:7.0f} / {joint:<6} "
@@ -415,9 +421,7 @@ def markdown(data: dict) -> str:
                   "59.8 m cm (goal) | locations × axes over the goal | `motion.joint` from s | mean / worst step |",
                   "|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for r in data["rates"]:
-            imu, far = r["points"][0], max(r["points"], key=lambda p: p["distance_m"])
-            over = sum(int(np.sum(np.asarray(p["rt_cm"]) > np.asarray(p["goal_cm"]))) for p in r["points"])
-            joint = "never" if r["joint_from_s"] is None else f"{r['joint_from_s']:.0f}"
+            imu, far, over, joint = rate_summary(r)
             lines.append(f"| {r['rate_hz']:g} | {r['roll_deg']:.3f} / {r['pitch_deg']:.3f} | "
                          f"{' / '.join(f'{x:.2f}' for x in imu['rt_cm'])} | "
                          f"{' / '.join(f'{x:.2f}' for x in imu['delayed_cm'])} | {far['rt_cm'][2]:.2f} "

@@ -143,8 +143,7 @@ class JointMotion:
         self.until_row = self.stride                # samples to the next taught row
         self.totals = (0.0,) * CHANNELS            # the channels' running sums
         self.angles = (0.0, 0.0, 0.0)              # the Euler rates' integral [rad]
-        self.last_rates: tuple[float, float, float] | None = None
-        self.last_channels: tuple[float, ...] = (0.0,) * 6     # the last good sample's
+        self.last_channels: tuple[float, ...] = (0.0,) * 6     # the last good sample's (rates: the trapezoid's)
         self.last_bad = -1 << 40                  # the newest step with a bad sample
         self.batch: list[np.ndarray] = []
         self.batch_targets: list[np.ndarray] = []
@@ -176,10 +175,10 @@ class JointMotion:
         if channels is None:
             self.last_bad = self.k
             channels = self.last_channels
+        previous = self.last_channels if self.k else channels     # the trapezoid's other end
         self.last_channels = channels
         u0, u1, u2, f0, f1, f2 = channels
-        l0, l1, l2 = self.last_rates or (u0, u1, u2)
-        self.last_rates = (u0, u1, u2)
+        l0, l1, l2 = previous[0], previous[1], previous[2]
         h = 0.5 * self.dt
         a0, a1, a2 = self.angles
         a0 += h * (l0 + u0)
@@ -290,7 +289,6 @@ class JointMotion:
     def get_state(self) -> dict:
         """JSON-serialisable state."""
         return {"k": self.k, "ring": self.ring.tolist(), "totals": list(self.totals), "angles": list(self.angles),
-                "last_rates": None if self.last_rates is None else list(self.last_rates),
                 "last_channels": list(self.last_channels),
                 "last_bad": self.last_bad, "batch": np.array(self.batch).tolist(),
                 "batch_targets": np.array(self.batch_targets).tolist(), "normal": self.normal.tolist(),
@@ -308,8 +306,7 @@ class JointMotion:
         self.until_row = int(s["until_row"])
         self.totals = tuple(float(v) for v in s["totals"])
         self.angles = tuple(float(v) for v in s["angles"])
-        self.last_rates = None if s["last_rates"] is None else tuple(float(v) for v in s["last_rates"])
-        self.last_channels = tuple(float(v) for v in s.get("last_channels", self.last_channels))
+        self.last_channels = tuple(float(v) for v in s["last_channels"])
         self.batch = list(np.array(s["batch"], dtype=float).reshape(-1, self.features_count))
         self.batch_targets = list(np.array(s["batch_targets"], dtype=float).reshape(-1, TARGETS))
         self.normal = np.array(s["normal"], dtype=float)
