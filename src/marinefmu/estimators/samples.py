@@ -1,5 +1,6 @@
 """Plausibility limits for single IMU samples, shared by the estimators: a sample beyond them
-is a sensor fault (the estimator coasts on its last good sample, see each ``step``)."""
+is a sensor fault (the estimator coasts on its last good sample, see each ``step``); and when a
+step counts as a change of the step size (:func:`step_changed`)."""
 from __future__ import annotations
 
 import math
@@ -15,6 +16,19 @@ MAX_TILT = math.radians(80.0)
 #: Largest |yaw| [rad] accepted from an attitude input: an unwrapped heading may grow with turns,
 #: but 1e4 rad is some 1,600 turns, beyond any single run.
 MAX_YAW = 1e4
+
+
+#: Relative change of the step [-] beyond which an estimator restarts for a new step size. An
+#: FMI master may pass each step as a difference of absolute times, t_{k+1} − t_k (FMPy does),
+#: which differs from the step by up to a rounding of t (2⁻⁵² t): relative to a step of 0.01 s
+#: that exceeds 10⁻⁹ from t = 2¹⁶ s (18 h) on, and 10⁻⁶ only from t = 2²⁶ s (2 years).
+STEP_TOLERANCE = 1e-6
+
+
+def step_changed(previous: float, dt: float) -> bool:
+    """Whether ``dt`` [s] differs from the step ``previous`` [s] by more than
+    :data:`STEP_TOLERANCE` of it (a NaN ``dt`` does not count: the callers check it apart)."""
+    return abs(dt - previous) > STEP_TOLERANCE * previous
 
 
 #: Squared specific force [m²/s⁴] below which a sample passes on float comparisons alone, a

@@ -235,6 +235,19 @@ def test_a_step_size_change_restarts_with_a_warning(short):
     assert "step size changed" in r.warning and not r.valid and mru.k == 1
 
 
+def test_steps_taken_as_differences_of_late_absolute_times_are_one_step(short):
+    """A master may pass t_{k+1} − t_k (FMPy does): 56 h into a run at 100 Hz those differ from
+    0.01 s by up to 2·10⁻⁹ of the step, a rounding of t: no restart (a tolerance of 10⁻⁹
+    restarted on a third of these steps)."""
+    gyro, acc = stack(short, "imu.gyro"), stack(short, "imu.acc")
+    times = 200000.0 + DT * np.arange(1001)                # as FMPy's start + n × interval
+    steps = np.diff(times)
+    assert np.mean(np.abs(steps / DT - 1.0) > 1e-9) > 0.2   # the wobble the tolerance has to pass
+    mru = MotionReferenceUnit(short_params(), quiet=True)
+    warnings = [mru.step(gyro[k], acc[k], float(dt)).warning for k, dt in enumerate(steps)]
+    assert mru.k == len(steps) and not any(warnings)
+
+
 @pytest.mark.parametrize("dt, says", [(0.0, "> 0"), (-0.01, "> 0"), (math.nan, "finite"), (math.inf, "finite")])
 def test_a_step_that_is_no_step_is_refused_naming_it_and_nothing_changes(short, dt, says):
     """A step that is not a finite number > 0 is refused, first or mid-run, with a message

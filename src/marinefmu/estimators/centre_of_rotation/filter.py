@@ -115,7 +115,7 @@ from .centred_window import (CentredWindow, derivative_gain_error, derivative_in
                              window_samples)
 from ..noise_meter import WhiteNoiseMeter
 from ..samples import (MAX_RATE, MAX_SPECIFIC_FORCE, MAX_TILT, MAX_YAW, angles_beyond_limit, force_beyond_limit,
-                       rate_beyond_limit)
+                       rate_beyond_limit, step_changed)
 
 log = logging.getLogger(__name__)
 
@@ -600,7 +600,7 @@ class CentreOfRotation:
             if self.last is None:
                 return self._invalid(warning)
             acc, gyro, ang = self.last
-        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
+        if self.dt is not None and step_changed(self.dt, dt):
             warning = f"step size changed from {self.dt} s to {dt} s; differentiation window restarted"
             log.warning("centre of rotation: %s", warning)
             self.dt = None

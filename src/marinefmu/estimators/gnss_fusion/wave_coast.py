@@ -71,6 +71,7 @@ from .antenna_attitude import matrix_rotvec
 from ..numerics import one_blas_thread
 from ..heave.bank import OscillatorBankHeave
 from ..heave.common import HeaveObserverParams
+from ..samples import step_changed
 
 #: Target rate of the band observers [Hz] (block means of the accelerometer samples).
 RATE = 20.0
@@ -205,7 +206,7 @@ class WaveCoast:
         """Take one attitude-corrected acceleration sample a_n [m/s², NED, gravity removed]
         over a step of ``dt`` s (a change of ``dt`` restarts the coaster), and with
         ``tilt_band`` the attitude R_nb that corrected it (needed then)."""
-        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
+        if self.dt is not None and step_changed(self.dt, dt):
             self.reset()
         if self.dt is None:
             self._start(dt)

@@ -24,6 +24,7 @@ from .common import (HeaveObserverParams, HeaveResult, SilentLog, backward_rate,
 from .fixed_lag import FixedLagOutputs
 from .oscillator_bank import BankModel, build_bank, carry_map
 from .spectrum import acceleration_spectrum, find_modes
+from ..samples import step_changed
 
 log = logging.getLogger(__name__)
 
@@ -122,7 +123,7 @@ class OscillatorBankHeave:
         if warning is not None:
             self.log.warning("heave observer: %s; coasting on the model", warning)
         restarted = None
-        if self.dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
+        if self.dt is not None and step_changed(self.dt, dt):
             restarted = f"step size changed from {self.dt} s to {dt} s; observer restarted"
             self.log.warning("heave observer: %s", restarted)
             self.reset()

@@ -62,7 +62,7 @@ from ...errors import check_choice, check_int, check_range, check_vector
 from ...frames import G
 from .band_bank import BAND_VARIANCES
 from .oscillator_bank import DISCRETISATIONS, MEASUREMENTS
-from ..samples import FORCE_PASS2, MAX_TILT, angles_beyond_limit, force_beyond_limit
+from ..samples import FORCE_PASS2, MAX_TILT, angles_beyond_limit, force_beyond_limit, step_changed
 
 
 class SilentLog:
@@ -343,7 +343,7 @@ def read_and_start(estimator: Any, acc: Any, roll: float, pitch: float,
     :class:`~.wiener.WienerHeave` have them): at the first step, or afresh when the step
     size changes (that reason then replaces the sample's)."""
     f, roll, pitch, warning = read_sample(acc, roll, pitch)
-    if estimator.dt is not None and abs(dt - estimator.dt) > 1e-9 * estimator.dt:
+    if estimator.dt is not None and step_changed(estimator.dt, dt):
         warning = f"step size changed from {estimator.dt} s to {dt} s; filter restarted"
         estimator.reset()
     if estimator.dt is None:

@@ -93,7 +93,7 @@ from ...frames import G, rot_nb_rows
 from ..attitude.estimator import AttitudeEstimator, AttitudeResult
 from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis, WienerGroup
-from ..samples import MAX_YAW
+from ..samples import MAX_YAW, step_changed
 from .joint import JointMotion, linear_channels
 from .level_frame import GyroTilt, SlowLowPass, acceleration_weights, level_rows, location_map, turn_rate_rows, unwrap
 from .params import ARM_TAU, COARSEST_MEASURED_STEP, YAW_TAU, MotionReferenceUnitParams, MruResult
@@ -279,7 +279,7 @@ class MotionReferenceUnit:
             Whether ``heading`` holds a measurement.
         """
         restart = None
-        if self.dt is None or not abs(dt - self.dt) <= 1e-9 * self.dt:      # a NaN step too
+        if self.dt is None or not math.isfinite(dt) or step_changed(self.dt, dt):
             dt = self.params.check_step(dt)           # refused before anything changes
             if self.dt is not None:
                 restart = f"step size changed from {self.dt} s to {dt} s; every filter restarted"
