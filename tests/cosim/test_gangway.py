@@ -16,7 +16,7 @@ RECORD_LIBCOSIM = ["mru.roll", "mru.pitch", "mru.mp1.surge", "mru.mp1.sway", "mr
 @pytest.mark.isolated(timeout=900)
 def test_the_gangway_tip_motion_meets_its_goals_and_libcosim_repeats_it(fmu_dir, tmp_path):
     """The whole scenario (900 s) under the FMPy runner, scored against the vessel's truth; the
-    first 200 s (the unit valid from about 140 s) under libcosim, in a second process at the same
+    first 200 s (the unit valid from 131 s) under libcosim, in a second process at the same
     time, equal to rounding (relative 1e-9, sampled every second: libcosim's time is integer
     nanoseconds)."""
     from marinefmu.analysis.html_report import write_report

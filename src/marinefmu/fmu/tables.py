@@ -329,8 +329,9 @@ MRU_PARAMETERS: list[Variable] = [
     real("acc_noise", _MRU.motion.acc_noise, "m/s2/sqrt(Hz)", "Accelerometer white-noise density, (0, 1]"),
     real("delayed_lag", _MRU.motion.smoother_lag, "s", "Delay of the delayed outputs, [0, 120]"),
     real("heading_tau", _MRU.heading_tau, "s", "Time constant of the heading aid, [1, 3600]"),
-    Variable("motion_model", "string", _MRU.motion_model, "", "Real-time motion at the IMU: joint (all six IMU "
-             "channels, taught by the axis filters' delayed outputs) or axis (one filter per axis, paper 003)"),
+    Variable("motion_model", "string", _MRU.motion_model, "", "Real-time motion at the IMU: one of joint, axis "
+             "(joint: all six IMU channels, taught by the axis filters' delayed outputs; axis: one filter per axis, "
+             "paper 003)"),
     real("joint_memory", _MRU.joint_memory, "s", "Span of the joint filter's past, [10, 300]"),
     Variable("aid_reference", "boolean", _MRU.aid_reference, "", "The joint filter's horizontal motion is the "
              "attitude's aid reference once it has taken over (roll and pitch err 2-3 x less in waves)"),
