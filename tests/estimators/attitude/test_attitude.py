@@ -11,9 +11,10 @@ from marinefmu.errors import ParameterError
 from marinefmu.estimators.attitude.estimator import (
     AttitudeEstimator, AttitudeEstimatorParams, estimate_attitude, integrate_gyro, integrate_gyro_euler,
 )
+from marinefmu.bench.cases import case_record
 from marinefmu.papers.paper000_semisub import AIDING
 from marinefmu.frames import G, euler_to_quat, quat_from_rotvec, quat_mul, quat_to_euler, quat_to_rot, rot_nb
-from marinefmu.sea.motion_model import REAL_INDEX, VesselMotion, VesselMotionParams
+from marinefmu.sea.motion_model import REAL_INDEX, VesselMotion, VesselMotionParams, stack
 
 rng = np.random.default_rng(11)
 ANGLES = rng.uniform([-0.6, -0.5, -3.0], [0.6, 0.5, 3.0], size=(10, 3))
@@ -127,6 +128,121 @@ def test_bad_samples_coast_and_invalidate_without_nan():
     assert abs(r.yaw - 0.05 * 0.01 * 1.0) < 1e-12  # coasting kept the last good rate for the 3 bad steps
 
 
+NAN3 = (math.nan, math.nan, math.nan)
+
+
+@pytest.mark.parametrize("gyro,acc,warning", [
+    (NAN3, (0.0, 0.0, -G), "non-finite gyro sample: holding the last good gyro sample"),
+    ((0.0, 0.0, 0.01), (0.0, math.inf, -G),
+     "non-finite accelerometer sample: holding the last good accelerometer sample"),
+    ((0.0, 11.0, 0.0), (0.0, 0.0, -G), "gyro sample beyond ±10.0 rad/s: holding the last good gyro sample"),
+    ((0.0, 0.0, 0.01), (150.0, 0.0, -150.0),
+     "specific force beyond 200.0 m/s²: holding the last good accelerometer sample"),
+    (NAN3, (150.0, 0.0, -150.0), "non-finite gyro sample; specific force beyond 200.0 m/s²: "
+                                 "holding the last good gyro and accelerometer samples"),
+], ids=["nan-gyro", "inf-acc", "fast-gyro", "strong-acc", "both"])
+def test_a_bad_sample_is_flagged_naming_the_bad_sensor(gyro, acc, warning, caplog):
+    est = AttitudeEstimator(AttitudeEstimatorParams(init="given"))
+    est.step([0.0, 0.0, 0.01], [0.0, 0.0, -G], 0.01)
+    r = est.step(gyro, acc, 0.01)
+    assert (r.valid, r.warning) == (False, warning)
+    assert warning in caplog.text
+
+
+def test_a_good_sample_is_used_when_the_other_sensor_is_bad():
+    """Per-sensor hold, gyro-only integration (mode 0, no aid correction): a good gyro sample
+    turns the attitude through an accelerometer gap as through good samples, and a good
+    specific force is taken through a gyro gap."""
+    f = np.array([0.0, 0.0, -G])
+    rate = np.array([0.02, -0.01, 0.03])
+    good, gap = (AttitudeEstimator(AttitudeEstimatorParams(mode=0, init="given")) for _ in range(2))
+    for k in range(20):
+        w = rate * (1.0 + 0.1 * k)                      # a changing rate: holding it would show
+        good.step(w, f, 0.01)
+        r = gap.step(w, NAN3 if 5 <= k < 15 else f, 0.01)
+        assert r.valid == (not 5 <= k < 15)
+    assert gap.q.tolist() == good.q.tolist()
+    r = gap.step(NAN3, [0.1, 0.2, -G], 0.01)
+    assert not r.valid and gap._last_acc == (0.1, 0.2, -G)
+
+
+def test_a_held_specific_force_stays_fixed_in_frame_n():
+    """Through an accelerometer gap the last good specific force is turned back by each step's
+    gyro rotation: R̂ f is the last good sample's n-frame force throughout (to rounding),
+    rather than turning with the body (1.4 m/s² of its gravity horizontal after 0.5 s at 0.3 rad/s)."""
+    est = AttitudeEstimator(AttitudeEstimatorParams(mode=0, init="given", init_euler=(0.1, -0.05, 0.4)))
+    f = np.array([0.4, -0.3, -G])
+    w = np.array([0.3, -0.2, 0.1])
+    est.step(w, f, 0.01)
+    f_n = quat_to_rot(est.q) @ f
+    for _ in range(50):
+        assert not est.step(w, NAN3, 0.01).valid
+        np.testing.assert_allclose(quat_to_rot(est.q) @ np.array(est._last_acc), f_n, rtol=0.0, atol=1e-13)
+
+
+def test_the_gyro_noise_meter_takes_good_gyro_samples_through_an_accelerometer_gap():
+    rng = np.random.default_rng(2)
+    gyro = 1e-3 * rng.standard_normal((300, 3))
+    acc = np.array([0.0, 0.0, -G]) + 0.01 * rng.standard_normal((300, 3))
+    bad_acc, bad_gyro = acc.copy(), gyro.copy()
+    bad_acc[100:150] = np.nan
+    bad_gyro[100:150] = np.nan
+    meters = {}
+    for name, g, a in (("good", gyro, acc), ("acc gap", gyro, bad_acc), ("gyro gap", bad_gyro, acc)):
+        est = AttitudeEstimator(AttitudeEstimatorParams(level_time=0.5))
+        for k in range(300):
+            est.step(g[k], a[k], 0.01)
+        meters[name] = est.gyro_meter.get_state()
+    assert meters["acc gap"] == meters["good"]
+    # a gyro gap breaks the chain: 50 samples and the two that restart it give no difference
+    assert meters["good"]["time"] - meters["gyro gap"]["time"] == pytest.approx(0.52, abs=1e-9)
+
+
+@pytest.fixture(scope="module")
+def sea6():
+    """Research vessel, Hs 6 m / Tp 14 s, IMU at the COG, default MEMS IMU, 125 s at 100 Hz."""
+    rec = case_record("research36", 6.0, 14.0, "cog", duration=125.0)
+    return stack(rec, "imu.gyro"), stack(rec, "imu.acc"), np.c_[rec["truth.roll"], rec["truth.pitch"]]
+
+
+def run_with_gap(sea, gyro_gap: bool, acc_gap: bool):
+    """The estimator at its defaults over ``sea6``, a 0.5 s NaN gap from 55 s (levelled at 10 s,
+    the aid sized from 50 s) in the sensors named: the results of the gap and of the minute after."""
+    gyro, acc, _ = sea
+    est = AttitudeEstimator(AttitudeEstimatorParams())
+    out = []
+    for k in range(5500 + 50 + 6000):
+        bad = 5500 <= k < 5550
+        out.append(est.step(NAN3 if bad and gyro_gap else gyro[k], NAN3 if bad and acc_gap else acc[k], 0.01))
+    return out[5500:]
+
+
+def test_an_accelerometer_gap_in_a_high_sea_leaves_the_attitude_as_uninterrupted(sea6):
+    """A 0.5 s accelerometer-only gap: the good gyro keeps the attitude, so roll and pitch over
+    the minute after the gap differ from the uninterrupted run's by under 0.02° (measured
+    0.006°; on 30 gaps across the benchmark's Hs 6 m cases at most 0.04°) and their RMS errors
+    are within 15 % of its (measured −7 % and +3 %). Holding the gyro as well through the gap
+    leaves 0.46° and 2.5 times the pitch error here."""
+    _, _, truth = sea6
+    plain = run_with_gap(sea6, gyro_gap=False, acc_gap=False)
+    gap = run_with_gap(sea6, gyro_gap=False, acc_gap=True)
+    assert [r.valid for r in gap] == [False] * 50 + [True] * 6000
+    assert all("accelerometer" in r.warning and "gyro" not in r.warning for r in gap[:50])
+    angles = lambda rs: np.array([(r.roll, r.pitch) for r in rs[50:]])  # noqa: E731
+    assert np.degrees(np.max(np.abs(angles(gap) - angles(plain)))) < 0.02
+    rms = lambda rs: np.sqrt(np.mean((angles(rs) - truth[5550:11550]) ** 2, axis=0))  # noqa: E731
+    assert np.all(rms(gap) <= 1.15 * rms(plain)), np.degrees([rms(gap), rms(plain)])
+
+
+def test_a_gyro_gap_in_a_high_sea_coasts_flagged_and_finite(sea6):
+    """A 0.5 s gyro-only gap: the last good rate is held, so the outputs are flagged invalid
+    through the gap, finite, and valid again at the first good sample."""
+    gap = run_with_gap(sea6, gyro_gap=True, acc_gap=False)
+    assert [r.valid for r in gap] == [False] * 50 + [True] * 6000
+    assert all(r.warning.startswith("non-finite gyro sample") and "accelerometer" not in r.warning for r in gap[:50])
+    assert np.all(np.isfinite([(r.roll, r.pitch, r.yaw, *r.q) for r in gap]))
+
+
 @pytest.mark.parametrize("kwargs,match", [
     ({"mode": 2}, r"mode = 2 is out of range"),
     ({"vel_sigma": 0.0}, r"vel_sigma = 0.0 is out of range: must be in \(0.0, 100.0\]"),
@@ -148,5 +264,21 @@ def test_state_round_trip_through_json_reproduces_the_run():
     first = [a.step(gyro[k], acc[k], 0.01) for k in range(1000, 2000)]
     b = AttitudeEstimator(AttitudeEstimatorParams(level_time=2.0))
     b.set_state(saved)
+    second = [b.step(gyro[k], acc[k], 0.01) for k in range(1000, 2000)]
+    assert [r.q for r in first] == [r.q for r in second]
+
+
+def test_a_deep_copy_continues_as_the_original():
+    """copy.deepcopy (and pickle) copy Fᵀ's data apart from F; the copy re-links the view, or
+    its covariance would be propagated with a stale Fᵀ and its run would drift from the
+    original's."""
+    import copy
+
+    gyro, acc, _ = vessel_record(20.0, noise=True)
+    a = AttitudeEstimator(AttitudeEstimatorParams(level_time=2.0))
+    for k in range(1000):
+        a.step(gyro[k], acc[k], 0.01)
+    b = copy.deepcopy(a)
+    first = [a.step(gyro[k], acc[k], 0.01) for k in range(1000, 2000)]
     second = [b.step(gyro[k], acc[k], 0.01) for k in range(1000, 2000)]
     assert [r.q for r in first] == [r.q for r in second]
