@@ -7,7 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from marinefmu.estimators.mru.joint import CHANNELS, JointMotion, block_edges, linear_channels
+from marinefmu.estimators.mru.joint import (AGREEMENT_SETTLE, BLEND, CHANNELS, GATE, JointMotion, block_edges,
+                                           linear_channels, slow_rows)
 
 DT = 0.05
 LAG = 40
@@ -51,8 +52,9 @@ def teacher(target: np.ndarray) -> np.ndarray:
 
 def taught(channels: np.ndarray, targets: np.ndarray, bad: int | None = None) -> tuple[JointMotion, list]:
     """A filter fed ``channels`` and taught ``targets`` ``LAG`` samples late; its predictions
-    once it has a fit."""
-    joint = JointMotion(10.0, DT, LAG, FORGET)
+    once it has a fit. The bare least squares (``slow=False``): white-noise targets answer
+    constants and ramps too."""
+    joint = JointMotion(10.0, DT, LAG, FORGET, slow=False)
     predictions = []
     for k, x in enumerate(channels):
         joint.push(None if k == bad else tuple(x))
@@ -126,3 +128,49 @@ def test_the_linear_channels_are_the_euler_rates_and_the_tilted_force():
 def test_the_first_fit_waits_for_two_rows_per_weight(memory, dt):
     joint = JointMotion(memory, dt, 10, 600.0)
     assert joint.warmup_rows == 2 * joint.features_count
+
+
+@pytest.mark.parametrize("channel", (6, 7))
+def test_the_slow_rows_are_the_filters_own_rows_of_a_constant_force(channel):
+    """Each slow row is the row the filter builds from its own running sums when one horizontal
+    level specific force has been a unit constant for the memory's span and more."""
+    joint = JointMotion(10.0, DT, LAG, FORGET)
+    fed = JointMotion(10.0, DT, LAG, FORGET)
+    for _ in range(2 * int(joint.edges[-1]) + 1):
+        x = np.zeros(6)
+        x[channel - 3] = 1.0
+        fed.push(tuple(x))
+    row = fed.features()
+    row[-1] = 0.0
+    np.testing.assert_allclose(row, slow_rows(joint.edges)[channel - 6], rtol=1e-9, atol=1e-12)
+
+
+def test_a_departure_from_the_axis_filters_withholds_the_output_for_the_memory():
+    """Agreeing with the axis filters' real-time outputs (to white noise of 1 cm), the fitted
+    filter's check passes its prediction; one step beyond GATE × their RMS difference withholds
+    it, and the output comes back, blended in afresh, once the memory has passed that step."""
+    rng = np.random.default_rng(3)
+    joint = JointMotion(10.0, DT, LAG, FORGET)
+    joint.weights = rng.normal(size=(joint.features_count, 6))
+    joint._fold()
+    joint.fitted_at = joint.blend_from = 0
+
+    def step(offset: float = 0.0):
+        joint.push(tuple(rng.normal(size=6)))
+        now = joint.predict()
+        out = np.zeros((3, 4))
+        out[:, :2] = now.T + rng.normal(0.0, 0.01, (3, 2))
+        out[1, 0] += offset
+        return joint.check(now, out)
+
+    settle = int(AGREEMENT_SETTLE / DT)
+    got = [step() for _ in range(settle + 100)]
+    assert all(g is not None for g in got)
+    assert GATE * 0.01 < 0.5 < 100 * 0.01         # the offset below is far beyond the gate
+    k = joint.k
+    assert step(offset=0.5) is None and joint.disagreed and joint.distrusted_until == k + 1 + joint.edges[-1]
+    assert not joint.blended and joint.share() == 0.0
+    span = int(joint.edges[-1])
+    withheld = [step() for _ in range(span)]
+    assert all(g is None for g in withheld[:-1]) and withheld[-1] is not None    # k reaches event + span
+    assert joint.share() == 0.0 and step() is not None and joint.share() == DT / BLEND

@@ -40,6 +40,19 @@ gather and one product. Until the first fit (:data:`WARMUP_RATIO` taught rows pe
 gives nothing and the unit keeps its axis filters' outputs; after it the unit moves its outputs
 over to these in :data:`BLEND` s (:meth:`JointMotion.share`).
 
+**Inputs outside its teaching.** The fit is taught in the sea at a steady heading and heel; a
+heading change or a heel (a crane's load, ballast) puts into the rates, the angles and the
+level specific force inputs it never saw, whose response the least squares leaves free. The
+fit is held deaf to a constant offset of the level specific force over its memory
+(:func:`slow_rows`), which is what a heel leaves once its memory has passed it. While a change
+is within its memory the filter checks itself against the axis filters, which read the
+acceleration in a level frame that a heel does not reach (:meth:`JointMotion.check`): beyond
+:data:`GATE` × the two's running RMS difference it gives nothing (the unit uses the axis
+filters' outputs) until its memory has passed the last such step, and then blends back in over
+:data:`BLEND` s. It goes on learning meanwhile: the axis filters' delayed outputs, its teacher,
+are right through a heel, and a lasting change of the vessel's state is learnt rather than
+shut out.
+
 Hand-written least squares (numpy and ``scipy.linalg.cho_factor``): neither scipy, filterpy nor
 python-control fits a multichannel causal filter from data.
 """
@@ -79,6 +92,18 @@ RIDGE = 1e-7
 CHANNELS = 9
 #: Number of targets: position (3) then rate (3), surge, sway, heave.
 TARGETS = 6
+#: Weight of the slow inputs' rows in the fit (:func:`slow_rows`), relative to the taught rows'
+#: forgotten count: any weight from 10⁻³ on holds the response to nothing.
+SLOW_WEIGHT = 1.0
+#: The joint filter's output is distrusted when one of its six numbers (surge, sway, heave and
+#: their rates) departs from the axis filters' by more than GATE × their running RMS
+#: difference (:meth:`JointMotion.check`).
+GATE = 6.0
+#: Time constant of that running RMS [s], and the time it runs before the gate applies.
+AGREEMENT_TAU = 300.0
+AGREEMENT_SETTLE = 60.0
+#: Interval of the agreement check [s]: the difference is smooth at wave frequencies.
+CHECK_EVERY = 0.1
 
 
 def block_edges(memory: float, dt: float, resolution: float = RESOLUTION, longest: float = LONGEST_BLOCK,
@@ -93,6 +118,42 @@ def block_edges(memory: float, dt: float, resolution: float = RESOLUTION, longes
     while edges[-1] < n_max:
         edges.append(min(n_max, edges[-1] + min(longest_n, max(shortest_n, int(resolution * edges[-1])))))
     return np.array(edges)
+
+
+def block_row(sums: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """(F,) row from the (B + 1, 9) running sums at the block edges, newest edge first, and the
+    B block lengths [samples]: per block (newest first) the nine channels' means, the angles'
+    less the angles now, then 1."""
+    means = (sums[:-1] - sums[1:]) / lengths[:, None]
+    means[:, :3] -= means[0, :3]
+    return np.append(means.ravel(), 1.0)
+
+
+def slow_rows(edges: np.ndarray) -> np.ndarray:
+    """(2, F) rows (:func:`block_row`, the constant's column 0) of a unit constant in each
+    horizontal level specific force over the memory of block ``edges``: what a heel (a crane's
+    load, ballast) older than the memory leaves in the linearised force, g [θ, −φ, 0] more.
+    A row is 1 at every block of its channel, so with zero targets it holds the sum of that
+    channel's block weights, the fit's response to the offset, to nothing.
+
+    The sea puts no such offset into the taught rows beyond their mean, so the least squares
+    leaves that response free (decimetres of heave after a 2° heel); the axis filters reject
+    below ``omega_min`` by design. The vertical force, which a heel does not reach, is left
+    free, and so are a ramp in the forces and a constant in the rates (a heel still under way,
+    a steady turn), which look too much like the waves over a 60 s memory: holding the fit to
+    nothing there cost it up to 14 % of its accuracy in the sea (docs/decisions/mru-design.md);
+    :meth:`JointMotion.check` deals with those."""
+    n = int(edges[-1])
+    index = n - np.asarray(edges)                  # the edges' places in the memory, oldest first
+    lengths = np.diff(edges).astype(float)
+    rows = []
+    for channel in (6, 7):                         # the horizontal forces
+        x = np.zeros((n + 1, CHANNELS))
+        x[:, channel] = 1.0
+        row = block_row(np.cumsum(x, axis=0)[index], lengths)
+        row[-1] = 0.0
+        rows.append(row)
+    return np.array(rows)
 
 
 def linear_channels(gyro_unbiased: Any, roll: float, pitch: float, level_force: Any) -> tuple[float, ...]:
@@ -119,9 +180,12 @@ class JointMotion:
         Delay of the teacher's outputs [samples].
     forget : float
         Time constant of the fit's forgetting [s].
+    slow : bool
+        Hold the fit deaf to a constant force offset (:func:`slow_rows`); False for the bare
+        least squares.
     """
 
-    def __init__(self, memory: float, dt: float, lag_steps: int, forget: float) -> None:
+    def __init__(self, memory: float, dt: float, lag_steps: int, forget: float, slow: bool = True) -> None:
         self.dt = dt
         self.lag = lag_steps
         self.edges = block_edges(memory, dt, shortest=SHORTEST_BLOCK)
@@ -134,6 +198,10 @@ class JointMotion:
         self.refit_steps = max(1, int(round(REFIT / dt)))
         self.warmup_rows = WARMUP_RATIO * self.features_count
         self.decay = math.exp(-REFIT / forget)
+        self.slow = slow_rows(self.edges) if slow else None
+        self.check_steps = max(1, int(round(CHECK_EVERY / dt)))
+        self.beta = 1.0 - math.exp(-self.check_steps * dt / AGREEMENT_TAU)
+        self.settle_weight = 1.0 - math.exp(-AGREEMENT_SETTLE / AGREEMENT_TAU)
         self.reset()
 
     def reset(self) -> None:
@@ -153,6 +221,11 @@ class JointMotion:
         self.taught = 0                            # every row taught
         self.weights: np.ndarray | None = None     # (features, 6) W
         self.fitted_at: int | None = None          # the sample count at the first fit
+        self.blend_from: int | None = None         # the sample count the current blend began at
+        self.agree_ms = np.zeros(TARGETS)          # running mean square of joint − axis outputs
+        self.agree_weight = 0.0                    # its weight 1 − (1 − β)^n, for its start
+        self.distrusted_until = 0                  # the sample count from which the output is trusted
+        self.disagreed = False                     # this step's check found the two apart
         # [Vᵀ c]: the running sums' weights, then the constant, which meets the 1 at the end of
         # the gathered sums (rows contiguous)
         self.node_weights = np.zeros((TARGETS, len(self.edges) * CHANNELS + 1))
@@ -190,12 +263,49 @@ class JointMotion:
         self.ring[self.k % self.n] = t
         self.k += 1
 
-    def step(self, channels: tuple[float, ...] | None, outputs: np.ndarray, valid: bool) -> np.ndarray | None:
-        """:meth:`push`, :meth:`teach` and, once fitted, :meth:`predict` in one call (the
-        unit's every step once its axis filters give outputs)."""
+    def step(self, channels: tuple[float, ...] | None, outputs: np.ndarray, valid: bool,
+             compare: bool = True) -> np.ndarray | None:
+        """:meth:`push`, :meth:`teach` and, once fitted, :meth:`predict` and, if ``compare``,
+        :meth:`check` in one call (the unit's every step once its axis filters give outputs):
+        the (2, 3) position [m] and rate [m/s] now, or None (no fit yet, or distrusted).
+        ``compare`` false: the axis filters' outputs are not the motion's (after a gap they read
+        its stand-ins for a while), and the filter keeps whatever trust it had."""
+        self.disagreed = False
         self.push(channels)
         self.teach(outputs, valid)
-        return None if self.weights is None else self.predict()
+        if self.weights is None:
+            return None
+        now = self.predict()
+        if compare and (self.k % self.check_steps == 0 or self.k < self.distrusted_until):
+            return self.check(now, outputs)
+        return None if self.k < self.distrusted_until else now
+
+    def check(self, now: np.ndarray, outputs: np.ndarray) -> np.ndarray | None:
+        """``now`` (:meth:`predict`) if it agrees with the axis filters' real-time position and
+        rate (``outputs`` (axes, 4), columns 0-1), else None (module docstring).
+
+        Every :data:`CHECK_EVERY` s the difference d enters a running mean square per number
+        (exponential, :data:`AGREEMENT_TAU`, corrected for its start; not while distrusted); from
+        :data:`AGREEMENT_SETTLE` s on, |d| > :data:`GATE` × its RMS in any number distrusts the
+        output until the rows no longer hold this step (the memory, :attr:`edges`) and sets
+        :attr:`disagreed` on the step that starts it. Checked every step while distrusted, so
+        that a continuing departure keeps it; after it the blend (:meth:`share`) starts
+        again. The teaching goes on (module docstring)."""
+        d = (now - outputs[:3, :2].T).ravel()
+        weight = self.agree_weight
+        if weight >= self.settle_weight and np.any(d * d > GATE * GATE * self.agree_ms / weight):
+            self.disagreed = self.k >= self.distrusted_until
+            self.distrusted_until = self.k + int(self.edges[-1])
+            self.blended = False
+            self.blend_from = None
+            return None
+        if self.k < self.distrusted_until:
+            return None
+        if self.blend_from is None:
+            self.blend_from = self.k
+        self.agree_ms += self.beta * (d * d - self.agree_ms)
+        self.agree_weight = weight + self.beta * (1.0 - weight)
+        return now
 
     def gather(self, age: int = 0) -> np.ndarray:
         """(B + 1, 9) running sums at the block edges of the row ``age`` samples before the
@@ -205,10 +315,7 @@ class JointMotion:
     def features(self, age: int = 0) -> np.ndarray:
         """(F,) row of the sample ``age`` samples before the newest: per block (newest first) the
         nine channels' means, the angles' less the angles now, then 1."""
-        s = self.gather(age)
-        means = (s[:-1] - s[1:]) / self.lengths[:, None]
-        means[:, :3] -= means[0, :3]
-        return np.append(means.ravel(), 1.0)
+        return block_row(self.gather(age), self.lengths)
 
     def teach(self, outputs: np.ndarray, valid: bool) -> None:
         """After :meth:`push`: the axis filters' (axes, 4) outputs, whose rows 0-2, columns 2-3
@@ -240,6 +347,12 @@ class JointMotion:
         if self.taught < self.warmup_rows:
             return
         regular = self.normal.copy()
+        if self.slow is not None:
+            # the offsets at each force's RMS in the taught rows (its newest block, its samples),
+            # weighted as the taught rows together
+            scale = np.sqrt(np.diag(self.normal)[6:8] / self.rows)
+            slow = self.slow * scale[:, None]
+            regular += SLOW_WEIGHT * self.rows * (slow.T @ slow)
         regular.flat[::len(regular) + 1] += RIDGE * float(np.mean(np.diag(self.normal)))
         try:
             weights = cho_solve(cho_factor(regular, overwrite_a=True, check_finite=False), self.moment)
@@ -249,7 +362,7 @@ class JointMotion:
             self.weights = weights
             self._fold()
             if self.fitted_at is None:
-                self.fitted_at = self.k
+                self.fitted_at = self.blend_from = self.k
 
     def _fold(self) -> None:
         """V and c from W: the prediction as a product with the running sums at the edges.
@@ -269,11 +382,12 @@ class JointMotion:
         self.node_weights = np.ascontiguousarray(np.column_stack([v.reshape(-1, TARGETS).T, self.weights[-1]]))
 
     def share(self) -> float:
-        """Weight of the joint filter in the unit's outputs, 0 … 1: 0 until the first fit, then
-        rising linearly to 1 over :data:`BLEND` s (``blended`` from then on)."""
-        if self.fitted_at is None:
+        """Weight of the joint filter in the unit's outputs, 0 … 1: 0 until the first fit (or
+        while distrusted, :meth:`check`), then rising linearly to 1 over :data:`BLEND` s
+        (``blended`` from then on)."""
+        if self.blend_from is None:
             return 0.0
-        share = min(1.0, (self.k - self.fitted_at) * self.dt / BLEND)
+        share = min(1.0, (self.k - self.blend_from) * self.dt / BLEND)
         self.blended = share == 1.0
         return share
 
@@ -293,6 +407,8 @@ class JointMotion:
                 "last_bad": self.last_bad, "batch": np.array(self.batch).tolist(),
                 "batch_targets": np.array(self.batch_targets).tolist(), "normal": self.normal.tolist(),
                 "moment": self.moment.tolist(), "rows": self.rows, "taught": self.taught, "fitted_at": self.fitted_at,
+                "blend_from": self.blend_from, "blended": self.blended, "agree_ms": self.agree_ms.tolist(),
+                "agree_weight": self.agree_weight, "distrusted_until": self.distrusted_until,
                 "until_row": self.until_row,
                 "weights": None if self.weights is None else self.weights.tolist()}
 
@@ -302,6 +418,11 @@ class JointMotion:
         self.k, self.last_bad, self.rows = int(s["k"]), int(s["last_bad"]), float(s["rows"])
         self.taught = int(s["taught"])
         self.fitted_at = None if s["fitted_at"] is None else int(s["fitted_at"])
+        self.blend_from = None if s.get("blend_from") is None else int(s["blend_from"])
+        self.blended = bool(s.get("blended", False))
+        self.agree_ms = np.array(s.get("agree_ms", [0.0] * TARGETS), dtype=float)
+        self.agree_weight = float(s.get("agree_weight", 0.0))
+        self.distrusted_until = int(s.get("distrusted_until", 0))
         self.ring = np.array(s["ring"], dtype=float).reshape(self.n, CHANNELS)
         self.until_row = int(s["until_row"])
         self.totals = tuple(float(v) for v in s["totals"])

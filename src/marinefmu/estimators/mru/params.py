@@ -193,7 +193,7 @@ class MruResult:
         Why the sample was not used, if it was not.
     joint : bool
         The real-time motion at the IMU is the joint filter's (``motion_model = "joint"``, once
-        taught), else the axis filters'.
+        taught, while it agrees with the axis filters), else the axis filters'.
     """
 
     roll: float

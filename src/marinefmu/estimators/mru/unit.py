@@ -37,7 +37,12 @@ Per sample (:meth:`MotionReferenceUnit.step`):
    times less than the axis filters in surge and sway (the MotionReferenceUnit docs page's
    Accuracy section has the figures). ``motion_model = "axis"`` keeps the axis
    filters' real-time outputs (paper 003's observer per axis). The delayed outputs are the
-   axis filters' either way.
+   axis filters' either way. The joint filter checks itself against the axis filters'
+   real-time outputs (:meth:`~.joint.JointMotion.check`): where it departs from them (a
+   heading change or a heel, which it was never taught) the unit gives the axis filters'
+   outputs until the joint filter's memory has passed the departure, with a warning, and
+   ``joint`` is false; after a gap the check waits until the axis filters have read past it
+   (their longest span, ``axis_memory``: 180 s at the defaults).
 4. **Monitoring points**: each adds its lever arm's motion about its mean, R r − ⟨R r⟩ with
    R = Rz(ψ_w) Ry(θ) Rx(φ), its rate Ṙ r from the gyro (Ṙ = R [ω]× less the slow yaw's turn)
    and its acceleration (:mod:`.level_frame`), the exact rigid-body transfer (paper 003
@@ -94,7 +99,7 @@ from ..attitude.estimator import AttitudeEstimator, AttitudeResult
 from ..heave.common import HeaveObserverParams, SilentLog
 from ..heave.wiener import WienerAxis, WienerGroup
 from ..samples import MAX_YAW, step_changed
-from .joint import JointMotion, linear_channels
+from .joint import GATE, JointMotion, linear_channels
 from .level_frame import GyroTilt, SlowLowPass, acceleration_weights, level_rows, location_map, turn_rate_rows, unwrap
 from .params import ARM_TAU, COARSEST_MEASURED_STEP, YAW_TAU, MotionReferenceUnitParams, MruResult
 
@@ -220,6 +225,7 @@ class MotionReferenceUnit:
         self.next_sizing = 0                          # the sample count of the next surge or sway design
         self.gap_steps = 0                            # bad samples in the current run of them
         self.recovered_at = 0                         # the sample count from which the motion is valid again
+        self.compared_from = 0                        # the sample count from which the joint filter is checked
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -231,6 +237,7 @@ class MotionReferenceUnit:
                        interval=DESIGN_ROUNDS * m.peak_interval)
         self.weights = acceleration_weights(dt)
         self.lag_steps = self.axes[0].lag_steps
+        self.axis_memory = self.axes[0].blocks * self.axes[0].block   # the axis filters' longest span [samples]
         self.group.bind()
         ring = max(self.lag_steps + 1, self.weights.shape[1])
         # (R_hb − I) − ⟨R_hb − I⟩ row by row (level_frame: every point's d is a product with it),
@@ -301,6 +308,7 @@ class MotionReferenceUnit:
             self.gap_steps += 1
             # a count (k + 1 after this sample); never earlier than set (a step that leaves the band unsampled)
             self.recovered_at = max(self.recovered_at, self.k + 2 + int(math.ceil(RECOVERY * self.gap_steps)))
+            self.compared_from = self.k + 2 + self.axis_memory     # once the axis filters have read past it
         elif self.gap_steps:
             self.gap_steps = 0
         points = len(self.arms)
@@ -383,7 +391,8 @@ class MotionReferenceUnit:
         joint = self.joint
         now = None                                 # the joint filter's (2, 3) position and rate, once taught
         if joint is not None:
-            now = joint.step(channels, out, delayed_valid)
+            # checked against the axis filters' outputs only once those have read past the last gap
+            now = joint.step(channels, out, delayed_valid, motion_valid and self.k >= self.compared_from)
             if now is not None:
                 if not joint.blended:
                     share = joint.share()
@@ -392,6 +401,11 @@ class MotionReferenceUnit:
                 if joint.blended and self.params.aid_reference and self.attitude.aid_due(dt):
                     # the attitude reads it at its next aid only
                     self.attitude.aid_reference = self._aid_reference(now) if good else None
+            elif joint.disagreed:                  # distrusted (JointMotion.check): no reference from it
+                self.attitude.aid_reference = None
+                self.log.warning("mru: the joint filter's motion departs from the axis filters' by more than %g x their "
+                                 "usual difference (a heading change or a heel it was not taught?); the axis "
+                                 "filters' outputs are used for at least %.0f s", GATE, (joint.distrusted_until - joint.k) * dt)
         if not points:                             # the IMU's row only: views of this step's own outputs
             if now is None:
                 position, velocity = out[None, :3, 0], out[None, :3, 1]
@@ -472,7 +486,7 @@ class MotionReferenceUnit:
                 "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist(),
                 "joint": None if self.joint is None else self.joint.get_state(), "psi_bar": self.psi_bar,
                 "gyro_tilt": None if self.gyro_tilt is None else self.gyro_tilt.get_state(),
-                "gap_steps": self.gap_steps, "recovered_at": self.recovered_at}
+                "gap_steps": self.gap_steps, "recovered_at": self.recovered_at, "compared_from": self.compared_from}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -497,3 +511,4 @@ class MotionReferenceUnit:
         if self.gyro_tilt is not None:
             self.gyro_tilt.set_state(s.get("gyro_tilt"))
         self.gap_steps, self.recovered_at = int(s.get("gap_steps", 0)), int(s.get("recovered_at", 0))
+        self.compared_from = int(s.get("compared_from", 0))
