@@ -43,7 +43,7 @@ over to these in :data:`BLEND` s (:meth:`JointMotion.share`).
 **Inputs outside its teaching.** The fit is taught in the sea at a steady heading and heel; a
 heading change or a heel (a crane's load, ballast) puts into the rates, the angles and the
 level specific force inputs it never saw, whose response the least squares leaves free. The
-fit is held deaf to a constant offset of the level specific force over its memory
+fit is held deaf to a constant offset of the horizontal level specific force over its memory
 (:func:`slow_rows`), which is what a heel leaves once its memory has passed it. While a change
 is within its memory the filter checks itself against the axis filters, which read the
 acceleration in a level frame that a heel does not reach (:meth:`JointMotion.check`): beyond
@@ -181,8 +181,8 @@ class JointMotion:
     forget : float
         Time constant of the fit's forgetting [s].
     slow : bool
-        Hold the fit deaf to a constant force offset (:func:`slow_rows`); False for the bare
-        least squares.
+        Hold the fit deaf to a constant horizontal force offset (:func:`slow_rows`); False for
+        the bare least squares.
     """
 
     def __init__(self, memory: float, dt: float, lag_steps: int, forget: float, slow: bool = True) -> None:
