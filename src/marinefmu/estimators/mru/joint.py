@@ -120,17 +120,8 @@ def block_edges(memory: float, dt: float, resolution: float = RESOLUTION, longes
     return np.array(edges)
 
 
-def block_row(sums: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """(F,) row from the (B + 1, 9) running sums at the block edges, newest edge first, and the
-    B block lengths [samples]: per block (newest first) the nine channels' means, the angles'
-    less the angles now, then 1."""
-    means = (sums[:-1] - sums[1:]) / lengths[:, None]
-    means[:, :3] -= means[0, :3]
-    return np.append(means.ravel(), 1.0)
-
-
 def slow_rows(edges: np.ndarray) -> np.ndarray:
-    """(2, F) rows (:func:`block_row`, the constant's column 0) of a unit constant in each
+    """(2, F) rows (:meth:`JointMotion.features`, the constant's column 0) of a unit constant in each
     horizontal level specific force over the memory of block ``edges``: what a heel (a crane's
     load, ballast) older than the memory leaves in the linearised force, g [θ, −φ, 0] more.
     A row is 1 at every block of its channel, so with zero targets it holds the sum of that
@@ -143,17 +134,11 @@ def slow_rows(edges: np.ndarray) -> np.ndarray:
     a steady turn), which look too much like the waves over a 60 s memory: holding the fit to
     nothing there cost it up to 14 % of its accuracy in the sea (docs/decisions/mru-design.md);
     :meth:`JointMotion.check` deals with those."""
-    n = int(edges[-1])
-    index = n - np.asarray(edges)                  # the edges' places in the memory, oldest first
-    lengths = np.diff(edges).astype(float)
-    rows = []
-    for channel in (6, 7):                         # the horizontal forces
-        x = np.zeros((n + 1, CHANNELS))
-        x[:, channel] = 1.0
-        row = block_row(np.cumsum(x, axis=0)[index], lengths)
-        row[-1] = 0.0
-        rows.append(row)
-    return np.array(rows)
+    blocks = len(edges) - 1
+    rows = np.zeros((2, CHANNELS * blocks + 1))
+    for row, channel in zip(rows, (6, 7)):         # the horizontal forces
+        row[channel:-1:CHANNELS] = 1.0
+    return rows
 
 
 def linear_channels(gyro_unbiased: Any, roll: float, pitch: float, level_force: Any) -> tuple[float, ...]:
@@ -315,7 +300,10 @@ class JointMotion:
     def features(self, age: int = 0) -> np.ndarray:
         """(F,) row of the sample ``age`` samples before the newest: per block (newest first) the
         nine channels' means, the angles' less the angles now, then 1."""
-        return block_row(self.gather(age), self.lengths)
+        s = self.gather(age)
+        means = (s[:-1] - s[1:]) / self.lengths[:, None]
+        means[:, :3] -= means[0, :3]
+        return np.append(means.ravel(), 1.0)
 
     def teach(self, outputs: np.ndarray, valid: bool) -> None:
         """After :meth:`push`: the axis filters' (axes, 4) outputs, whose rows 0-2, columns 2-3
@@ -407,7 +395,7 @@ class JointMotion:
                 "last_bad": self.last_bad, "batch": np.array(self.batch).tolist(),
                 "batch_targets": np.array(self.batch_targets).tolist(), "normal": self.normal.tolist(),
                 "moment": self.moment.tolist(), "rows": self.rows, "taught": self.taught, "fitted_at": self.fitted_at,
-                "blend_from": self.blend_from, "blended": self.blended, "agree_ms": self.agree_ms.tolist(),
+                "blend_from": self.blend_from, "agree_ms": self.agree_ms.tolist(),
                 "agree_weight": self.agree_weight, "distrusted_until": self.distrusted_until,
                 "until_row": self.until_row,
                 "weights": None if self.weights is None else self.weights.tolist()}
@@ -419,7 +407,6 @@ class JointMotion:
         self.taught = int(s["taught"])
         self.fitted_at = None if s["fitted_at"] is None else int(s["fitted_at"])
         self.blend_from = None if s.get("blend_from") is None else int(s["blend_from"])
-        self.blended = bool(s.get("blended", False))
         self.agree_ms = np.array(s.get("agree_ms", [0.0] * TARGETS), dtype=float)
         self.agree_weight = float(s.get("agree_weight", 0.0))
         self.distrusted_until = int(s.get("distrusted_until", 0))
