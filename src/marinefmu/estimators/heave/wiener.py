@@ -523,6 +523,15 @@ class WienerGroup:
         self._node_taps = np.zeros((len(self.axes), 4, 1))
         self._offsets = np.zeros((len(self.axes), 4))     # mean × the taps' sums, per axis
 
+    def __setstate__(self, state: dict) -> None:
+        """Unpickled or deep-copied: each axis's ``sum_buf`` a view of its slab again (a copy
+        copies a view's data apart from its base; the axes' updates would then miss the slab
+        the outputs are read from)."""
+        self.__dict__.update(state)
+        if self.sums.ndim == 3:                            # bound
+            for row, axis in zip(self.sums, self.axes):
+                axis.sum_buf = row
+
     def bind(self) -> None:
         """Move the axes' running sums into one array (after their ``start`` or ``set_state``)."""
         first = self.axes[0]

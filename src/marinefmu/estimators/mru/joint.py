@@ -219,6 +219,13 @@ class JointMotion:
         self.nodes = self.flat_nodes[:-1].reshape(len(self.edges), CHANNELS)   # a view: the gather lands in it
         self.blended = False                        # the joint filter's share has reached 1
 
+    def __setstate__(self, state: dict) -> None:
+        """Unpickled or deep-copied: ``nodes`` a view of ``flat_nodes`` again (a copy copies a
+        view's data apart from its base, and the gather would land where the prediction does not
+        read)."""
+        self.__dict__.update(state)
+        self.nodes = self.flat_nodes[:-1].reshape(len(self.edges), CHANNELS)
+
     @property
     def ready(self) -> bool:
         """Whether a fit exists."""
