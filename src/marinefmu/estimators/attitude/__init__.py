@@ -11,6 +11,8 @@ module                     paper 000
 :mod:`.estimator`          quaternion kinematics (eqs. 6-7), Euler angles from the
                            quaternion (eqs. 8-9), exact rotation per step; the aided
                            variant (beyond the paper) that bounds the gyro drift
+:mod:`.gyro_coast`         the coast error of a gyro gap in the aided variant's covariance,
+                           and the recovery that holds ``valid`` after it (beyond the paper)
 :mod:`.tilt_refinement`    batch refinement of roll and pitch from the record's gravity
                            direction (beyond the paper; post-processing)
 ========================== ===============================================================

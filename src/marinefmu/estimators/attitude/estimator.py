@@ -100,9 +100,15 @@ accelerometer triplet are checked each on its own: non-finite, a rate component 
 sensor's last good one and a good triplet is used, so a saturated or dropped accelerometer does
 not stop the gyro integration, which carries the attitude through an accelerometer gap as
 through good samples. A held rate extrapolates the motion: the attitude errs by the rate's
-change integrated over the gap (up to 0.9° after 0.5 s in a 6 m sea), which the aid removes
-over its own time scale, one to two minutes; a caller that needs to can keep its outputs
-flagged for a while after a gyro gap.
+change integrated over the gap (0.2-0.8° after 0.5 s in a 6 m sea, degrees after 2 s). In
+mode 1 a bound on that error goes into the tilt's covariance as the gap goes on
+(:mod:`~marinefmu.estimators.attitude.gyro_coast`), so the aid trusts its measurements again
+and removes it sooner (to within 0.05° of the uninterrupted run: 14-86 s after a 0.5 s gap
+in research36's 6 m sea and 20-96 s after a 2 s gap, where the steady gains alone take
+49-108 s and 72-587 s), and
+``valid`` stays false after the gap until the tilt's and the gyro bias's variances are back
+near the uninterrupted filter's (30-90 s after a 0.5 or 2 s gap in the benchmark's seas, up to
+15 s after a 0.1 s one).
 A held specific force is kept fixed in frame n (in the levelling frame while levelling),
 turned back by each step's gyro rotation: its gravity stays vertical, where held fixed in the
 body it would put g × (the angle turned in the gap) into the horizontal acceleration the aid
@@ -110,7 +116,9 @@ integrates. The aid goes on integrating and updating through an accelerometer ga
 force misses only the change of the horizontal wave acceleration over the gap, while leaving
 the acceleration out of the integration misses all of it.
 Every step with a bad triplet gives ``valid`` False and a ``warning`` naming the bad sensor and
-what is held; a good sample after it is valid again (once levelled).
+what is held; a good sample after it is valid again (once levelled, and, after a gyro gap in
+mode 1, once recovered: the steps between have no warning, the recovery's start and end are
+logged at INFO level).
 """
 from __future__ import annotations
 
@@ -124,6 +132,7 @@ import numpy as np
 from ...errors import check_choice, check_int, check_range, check_vector
 from ...frames import euler_to_quat, half_angle_coefficients, level_angles, quat_mul, quat_to_euler
 from ..noise_meter import WhiteNoiseMeter
+from .gyro_coast import RECOVERED, RECOVERED_BIAS, GyroCoast
 from ..samples import FORCE_PASS2, MAX_RATE, force_beyond_limit, rate_beyond_limit
 
 log = logging.getLogger(__name__)
@@ -238,7 +247,9 @@ class AttitudeResult:
     gyro_bias : tuple of float
         Estimated gyro bias [rad/s, b] (z is not observable and stays 0).
     valid : bool
-        False while levelling and on a sample with a rejected gyro or accelerometer triplet.
+        False while levelling, on a sample with a rejected gyro or accelerometer triplet, and
+        (mode 1) after a rejected gyro triplet until the aid has removed the coast error
+        (module docstring, *Bad samples*).
     warning : str or None
         For a rejected triplet: which sensor's, why, and what is held, e.g.
         ``"non-finite accelerometer sample: holding the last good accelerometer sample"``;
@@ -383,6 +394,12 @@ class AttitudeEstimator:
         self._FT = self._F.T                       # a view: F's entries change in place each step
         self._FP = np.empty((8, 8))
         self._z = np.empty((4, 1))
+        #: Whether a gyro gap's coast error goes into the covariance and holds ``valid`` until
+        #: the aid has removed it (module docstring, *Bad samples*). The MotionReferenceUnit
+        #: turns it off: its aid reference comes from a motion filter that carries the coast
+        #: error itself after the gap, so the inflated filter would follow it (17° swings after
+        #: a 2 s gap), and the unit holds its angles for as long as its motion instead.
+        self.recover_from_gyro_gaps = True
         self.reset()
 
     def __setstate__(self, state: dict) -> None:
@@ -427,6 +444,10 @@ class AttitudeEstimator:
         #: None for zero (module docstring).
         self.aid_reference: tuple[float, float, float, float] | None = None
         self._referenced = False                 # the last update used a reference
+        self.coast = GyroCoast(STATS_TAU)        # a gyro gap's cost to the tilt, and the recovery
+        #: Whether the gyro triplet of the last sample with a warning passed (on a step with a
+        #: warning: whether the warning is the accelerometer's alone).
+        self.gyro_good = True
 
     # ---- read-only views of the state as arrays ------------------------------------------------
     @property
@@ -470,8 +491,9 @@ class AttitudeEstimator:
             replaced by the last good rate, so the attitude coasts on it; a bad specific force by
             the last good one held fixed in frame n, while a good rate beside it is integrated
             as usual (the attitude needs the gyro, the accelerometer only corrects its slow
-            drift). ``valid`` is then False and ``warning`` names the bad sensor. Before the
-            first good sample there is nothing to hold: the state is left as it is.
+            drift). ``valid`` is then False and ``warning`` names the bad sensor; after a gyro
+            gap ``valid`` stays False until the recovery (module docstring). Before the first
+            good sample there is nothing to hold: the state is left as it is.
         """
         gx, gy, gz = gyro
         ax, ay, az = acc
@@ -480,6 +502,7 @@ class AttitudeEstimator:
         if (-MAX_RATE <= gx <= MAX_RATE and -MAX_RATE <= gy <= MAX_RATE and -MAX_RATE <= gz <= MAX_RATE
                 and ax * ax + ay * ay + az * az <= FORCE_PASS2):
             warning = None
+            gyro_good = True
             if self._auto:
                 self.gyro_meter.push(np.array((gx, gy, gz)), dt)
         else:
@@ -487,6 +510,7 @@ class AttitudeEstimator:
             if sample is None:                       # nothing to hold yet
                 return self._result(False, warning)
             gx, gy, gz, ax, ay, az = sample
+            gyro_good = self.gyro_good
         last = self._last_gyro
         px, py, pz = (gx, gy, gz) if last is None else last
         bx, by, bz = self._bias
@@ -498,7 +522,9 @@ class AttitudeEstimator:
         qw, qx, qy, qz = self._q
         self._q = _quat_step(qw, qx, qy, qz, wx * dt, wy * dt, wz * dt)
         if self._mode1:
-            self._aid(ax, ay, az, dt)
+            self._aid(ax, ay, az, wx, wy, dt)
+            if self.coast.shadow is not None:        # after a gyro gap, until the aid has removed its error
+                return self._result(self._recovered(gyro_good) and warning is None, warning)
         return self._result(warning is None, warning)
 
     def _screen(self, gx: float, gy: float, gz: float, ax: float, ay: float, az: float,
@@ -518,6 +544,7 @@ class AttitudeEstimator:
         bad one breaks its chain (a second difference spans consecutive good samples only).
         """
         bad_gyro, bad_acc = _bad_sample(np.array((gx, gy, gz)), np.array((ax, ay, az)))
+        self.gyro_good = bad_gyro is None
         if bad_gyro is None:
             if self._auto:
                 self.gyro_meter.push(np.array((gx, gy, gz)), dt)
@@ -534,6 +561,8 @@ class AttitudeEstimator:
             return warning, None
         if bad_gyro:
             gx, gy, gz = last
+            if self._mode1 and not self.levelling and self.recover_from_gyro_gaps:
+                self._coast(dt)
         if bad_acc:
             # Through an accelerometer gap the aid integrates and updates on the last good force
             # held fixed in frame n: it misses only the change of the wave acceleration over the
@@ -551,6 +580,39 @@ class AttitudeEstimator:
             ay = fy + 2.0 * (w * cy + z * cx - x * cz)
             az = fz + 2.0 * (w * cz + x * cy - y * cx)
         return warning, (gx, gy, gz, ax, ay, az)
+
+    def _coast(self, dt: float) -> None:
+        """One step on a held rate: the tilt's variances in P grow by the coast error's
+        (:mod:`~marinefmu.estimators.attitude.gyro_coast`); at the gap's start
+        the covariance without the inflation begins as a copy of P."""
+        coast = self.coast
+        coast.break_chain()
+        P = self.kf.P
+        if coast.shadow is None:
+            coast.shadow = P.copy()
+        grow = coast.held_step(dt)
+        P[4, 4] += grow
+        P[5, 5] += grow
+
+    def _recovered(self, gyro_good: bool) -> bool:
+        """Whether the tilt's and the x/y gyro bias's variances are back within
+        :data:`~.gyro_coast.RECOVERED` and :data:`~.gyro_coast.RECOVERED_BIAS` × their values
+        without the last gyro gap's inflation (then the recovery ends, logged)."""
+        coast = self.coast
+        if not gyro_good:
+            return False
+        if coast.held:
+            log.info("attitude: gyro back after %.3g s on a held rate; roll and pitch are flagged invalid until "
+                     "the aid has removed the coast error", coast.held)
+            coast.gap_ended()
+        P, S = self.kf.P, coast.shadow
+        if (P[4, 4] + P[5, 5] > RECOVERED * (S[4, 4] + S[5, 5])
+                or P[6, 6] + P[7, 7] > RECOVERED_BIAS * (S[6, 6] + S[7, 7])):
+            return False
+        coast.shadow = None
+        log.info("attitude: recovered from the gyro gap (tilt and gyro bias variances within %g and %g x their values "
+                 "without the gap)", RECOVERED, RECOVERED_BIAS)
+        return True
 
     def aid_due(self, dt: float) -> bool:
         """Whether the next step, of ``dt`` s, makes an aid update (the one step that reads
@@ -583,8 +645,10 @@ class AttitudeEstimator:
         self._dt = dt
         np.multiply(self._q_diag, dt, out=self._q_dt)
 
-    def _aid(self, ax: float, ay: float, az: float, dt: float) -> None:
-        """Velocity- and position-aided tilt and gyro-bias correction (module docstring)."""
+    def _aid(self, ax: float, ay: float, az: float, wx: float, wy: float, dt: float) -> None:
+        """Velocity- and position-aided tilt and gyro-bias correction (module docstring);
+        ``wx``, ``wy`` the step's bias-corrected horizontal body rates [rad/s] for the rate
+        statistics of :class:`~.gyro_coast.GyroCoast`."""
         w, x, y, z = self._q
         ww, xx, yy, zz = w * w, x * x, y * y, z * z
         r00, r01, r02 = ww + xx - yy - zz, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
@@ -615,8 +679,12 @@ class AttitudeEstimator:
         np.dot(F, P, out=self._FP)
         np.dot(self._FP, self._FT, out=P)
         P += self._q_dt
+        shadow = self.coast.shadow
+        if shadow is not None:                       # the covariance without a gyro gap's inflation
+            shadow[...] = F @ shadow @ self._FT + self._q_dt
         self.since_aid += dt
         if self.since_aid >= self._aid_period:
+            self.coast.push(wx, wy, self.since_aid)
             self.since_aid = 0.0
             ref = self.aid_reference
             R = kf.R
@@ -642,6 +710,8 @@ class AttitudeEstimator:
             else:
                 zv[0, 0], zv[1, 0], zv[2, 0], zv[3, 0] = pos[0] - ref[0], pos[1] - ref[1], vel[0] - ref[2], vel[1] - ref[3]
             dx, kf.P = aid_update(P, kf.R, zv)
+            if shadow is not None:
+                shadow[...] = aid_update(shadow, kf.R, zv)[1]
             d = dx[:, 0].tolist()
             pos[0] -= d[0]
             pos[1] -= d[1]
@@ -719,7 +789,7 @@ class AttitudeEstimator:
             "gyro_meter": self.gyro_meter.get_state(), "gyro_noise_used": self.gyro_noise_used,
             "gyro_bias_sigma_used": self.gyro_bias_sigma_used,
             "aid_reference": None if self.aid_reference is None else list(self.aid_reference),
-            "referenced": self._referenced,
+            "referenced": self._referenced, "coast": self.coast.get_state(), "gyro_good": self.gyro_good,
         }
 
     def set_state(self, s: dict) -> None:
@@ -746,6 +816,9 @@ class AttitudeEstimator:
         ref = s.get("aid_reference")
         self.aid_reference = None if ref is None else tuple(floats(ref))
         self._referenced = bool(s.get("referenced", False))
+        if "coast" in s:                             # a state saved before the coast statistics has none
+            self.coast.set_state(s["coast"])
+        self.gyro_good = bool(s.get("gyro_good", True))
         self._dt = None
         self._set_gyro_process_noise()
 

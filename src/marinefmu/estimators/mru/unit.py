@@ -202,6 +202,7 @@ class MotionReferenceUnit:
         """Back to the initial state."""
         p = self.params
         self.attitude = AttitudeEstimator(p.attitude)
+        self.attitude.recover_from_gyro_gaps = False     # the angles wait for the motion after a gyro gap (step)
         horizontal = horizontal_params(p)
         self.axes = [WienerAxis(p.motion if name == "heave" else horizontal, self.log, f"mru {name}",
                                 reject_below=name != "heave", find_steps=name == "heave") for name in AXES]
@@ -226,6 +227,7 @@ class MotionReferenceUnit:
         self.gap_steps = 0                            # bad samples in the current run of them
         self.recovered_at = 0                         # the sample count from which the motion is valid again
         self.compared_from = 0                        # the sample count from which the joint filter is checked
+        self.angles_from = 0                          # the sample count from which the angles are valid again
 
     def start(self, dt: float) -> None:
         """Size the buffers for the step ``dt`` [s]."""
@@ -303,12 +305,16 @@ class MotionReferenceUnit:
                 self.log.warning("mru: step %g s is coarser than the %g s the unit's accuracy is measured at; "
                                  "expect larger errors", dt, COARSEST_MEASURED_STEP)
         att = self.attitude.step(gyro, acc, dt)
-        good = att.valid and att.warning is None
+        # a good sample on a levelled attitude feeds the filters, also while the attitude is
+        # recovering from a gyro gap (its valid false): its angles are the best there are
+        good = att.warning is None and not self.attitude.levelling
         if att.warning is not None:                    # a bad sample: the motion recovers after the gap
             self.gap_steps += 1
             # a count (k + 1 after this sample); never earlier than set (a step that leaves the band unsampled)
             self.recovered_at = max(self.recovered_at, self.k + 2 + int(math.ceil(RECOVERY * self.gap_steps)))
             self.compared_from = self.k + 2 + self.axis_memory     # once the axis filters have read past it
+            if not self.attitude.gyro_good:            # a gyro gap: the angles as the motion (below)
+                self.angles_from = self.recovered_at
         elif self.gap_steps:
             self.gap_steps = 0
         points = len(self.arms)
@@ -378,7 +384,10 @@ class MotionReferenceUnit:
         else:
             yaw_out, heading_used, heading_warning = self._heading(att.yaw, heading, heading_valid, dt)
         warning = restart or att.warning or heading_warning
-        angles_valid = att.valid and heading_warning is None
+        # after a gyro gap the attitude needs its aid reference to come back, which comes from
+        # the joint filter, and that carries the coast error until it has read past the gap: the
+        # angles wait for the motion's recovery
+        angles_valid = att.valid and heading_warning is None and self.k >= self.angles_from
         if out is None:
             if self.joint is not None:
                 self.joint.push(channels)
@@ -386,7 +395,7 @@ class MotionReferenceUnit:
             return MruResult(att.roll, att.pitch, yaw_out, zeros, zeros, zero_acc, zeros, self.delay_s,
                              heave_axis.peak_period, angles_valid, False, False, heading_used, warning)
         delayed_ready = self.k * dt >= self.delayed_from     # before it the delayed outputs are zeros
-        motion_valid = good and self.k >= self.recovered_at
+        motion_valid = good and att.valid and self.k >= self.recovered_at
         delayed_valid = motion_valid and delayed_ready and self.k >= self.recovered_at + self.lag_steps
         joint = self.joint
         now = None                                 # the joint filter's (2, 3) position and rate, once taught
@@ -486,7 +495,8 @@ class MotionReferenceUnit:
                 "rot": self.rot.tolist(), "heave_acc": self.heave_acc, "turn_ring": self.turn_ring.tolist(),
                 "joint": None if self.joint is None else self.joint.get_state(), "psi_bar": self.psi_bar,
                 "gyro_tilt": None if self.gyro_tilt is None else self.gyro_tilt.get_state(),
-                "gap_steps": self.gap_steps, "recovered_at": self.recovered_at, "compared_from": self.compared_from}
+                "gap_steps": self.gap_steps, "recovered_at": self.recovered_at, "compared_from": self.compared_from,
+                "angles_from": self.angles_from}
 
     def set_state(self, s: dict) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -511,4 +521,5 @@ class MotionReferenceUnit:
         if self.gyro_tilt is not None:
             self.gyro_tilt.set_state(s.get("gyro_tilt"))
         self.gap_steps, self.recovered_at = int(s.get("gap_steps", 0)), int(s.get("recovered_at", 0))
+        self.angles_from = int(s.get("angles_from", 0))
         self.compared_from = int(s.get("compared_from", 0))
