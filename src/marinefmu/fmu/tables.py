@@ -367,7 +367,7 @@ MRU_OUTPUTS: list[Variable] = [
     real("wave_period", 0.0, "s", "Dominant wave period: the peak of the heave spectrum (0 before the first)"),
 ]
 MRU_BOOLEANS: list[Variable] = [
-    Variable("valid", "boolean", False, "", "roll, pitch, yaw: false while levelling, on a rejected (NaN/Inf/absurd) sample, and for 120 x a gyro gap's length after it"),
+    Variable("valid", "boolean", False, "", "roll, pitch, yaw: false while levelling, on a rejected (NaN/Inf/absurd) sample, and for 120 x the length of a gyro gap whose coast error can exceed the tilt's uncertainty"),
     Variable("motion.valid", "boolean", False, "", "The real-time motion: false until every axis's first spectrum, on a rejected sample and for 120 x a run of them after it"),
     Variable("delayed.valid", "boolean", False, "", "The delayed outputs refer to a time the filters have run through (and a run of rejected samples is 120 x its length and delayed_lag behind)"),
     Variable("heading.used", "boolean", False, "", "yaw is north-referenced"),

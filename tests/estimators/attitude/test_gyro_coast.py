@@ -35,8 +35,8 @@ def coast_sigma(c: GyroCoast, gap: float, dt: float = 0.01) -> float:
 
 
 def test_a_short_gap_costs_the_angular_acceleration_times_half_its_square():
-    """While σ_ω̇ τ < √2 σ_ω the error grows as σ_ω̇ T²/2: the midpoint rule integrates the
-    linear growth exactly; a gap ends, and the next starts from nothing."""
+    """While σ_ω̇ τ < 2σ_ω the error grows as σ_ω̇ T²/2, step by step as in one; a gap
+    ends, and the next starts from nothing."""
     c = sine_coast()
     sigma_acc = math.sqrt(c.ms_accel / c.weight)
     assert coast_sigma(c, 0.5) == pytest.approx(sigma_acc * 0.5 ** 2 / 2, rel=1e-9)

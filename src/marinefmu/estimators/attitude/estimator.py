@@ -398,7 +398,8 @@ class AttitudeEstimator:
         #: the aid has removed it (module docstring, *Bad samples*). The MotionReferenceUnit
         #: turns it off: its aid reference comes from a motion filter that carries the coast
         #: error itself after the gap, so the inflated filter would follow it (17° swings after
-        #: a 2 s gap), and the unit holds its angles for as long as its motion instead.
+        #: a 2 s gap), and the unit holds its angles for as long as its motion instead, when
+        #: :meth:`GyroCoast.bound <.gyro_coast.GyroCoast.bound>` says the gap can matter.
         self.recover_from_gyro_gaps = True
         self.reset()
 
@@ -561,8 +562,10 @@ class AttitudeEstimator:
             return warning, None
         if bad_gyro:
             gx, gy, gz = last
-            if self._mode1 and not self.levelling and self.recover_from_gyro_gaps:
-                self._coast(dt)
+            if self._mode1 and not self.levelling:
+                self.coast.break_chain()
+                if self.recover_from_gyro_gaps:
+                    self._coast(dt)
         if bad_acc:
             # Through an accelerometer gap the aid integrates and updates on the last good force
             # held fixed in frame n: it misses only the change of the wave acceleration over the
@@ -586,7 +589,6 @@ class AttitudeEstimator:
         (:mod:`~marinefmu.estimators.attitude.gyro_coast`); at the gap's start
         the covariance without the inflation begins as a copy of P."""
         coast = self.coast
-        coast.break_chain()
         P = self.kf.P
         if coast.shadow is None:
             coast.shadow = P.copy()

@@ -99,17 +99,23 @@ class GyroCoast:
         """A held rate: the next push starts a new difference."""
         self.last = None
 
-    def held_step(self, dt: float) -> float:
-        """One step of ``dt`` [s] on the held rate: the growth of the coast error's variance
-        σ_e² over it [rad²] (module docstring, the integral by the midpoint rule; 0 before the
-        statistics have a sample)."""
-        self.held += dt
+    def bound(self, gap: float) -> float:
+        """σ_e [rad] after ``gap`` [s] on a held rate (module docstring, the integral in closed
+        form; 0 before the statistics have a sample)."""
         if self.weight <= 0.0:
             return 0.0
-        w = self.weight
-        tau = self.held - 0.5 * dt                  # the step's midpoint
+        a = math.sqrt(self.ms_accel / self.weight)          # σ_ω̇
+        b = 2.0 * math.sqrt(self.ms_rate / self.weight)      # 2σ_ω
+        if a * gap <= b:
+            return 0.5 * a * gap * gap
+        return b * (gap - 0.5 * b / a)                      # ½ a t₀² + b (T − t₀), t₀ = b / a
+
+    def held_step(self, dt: float) -> float:
+        """One step of ``dt`` [s] on the held rate: the growth of the coast error's variance
+        σ_e² over it [rad²]."""
+        self.held += dt
         before = self.std
-        self.std += min(math.sqrt(self.ms_accel / w) * tau, 2.0 * math.sqrt(self.ms_rate / w)) * dt
+        self.std = self.bound(self.held)
         return self.std * self.std - before * before
 
     def gap_ended(self) -> None:
