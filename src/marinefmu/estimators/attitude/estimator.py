@@ -105,10 +105,9 @@ mode 1 a bound on that error goes into the tilt's covariance as the gap goes on
 (:mod:`~marinefmu.estimators.attitude.gyro_coast`), so the aid trusts its measurements again
 and removes it sooner (to within 0.05° of the uninterrupted run: 14-86 s after a 0.5 s gap
 in research36's 6 m sea and 20-96 s after a 2 s gap, where the steady gains alone take
-49-108 s and 72-587 s), and
-``valid`` stays false after the gap until the tilt's and the gyro bias's variances are back
-near the uninterrupted filter's (30-90 s after a 0.5 or 2 s gap in the benchmark's seas, up to
-15 s after a 0.1 s one).
+49-108 s and 72-587 s), and ``valid`` stays false after the gap until the tilt's and the gyro
+bias's variances are back near the uninterrupted filter's (20-91 s after a 0.5 or 2 s gap in
+the benchmark's seas, up to 15 s after a 0.1 s one).
 A held specific force is kept fixed in frame n (in the levelling frame while levelling),
 turned back by each step's gyro rotation: its gravity stays vertical, where held fixed in the
 body it would put g × (the angle turned in the gap) into the horizontal acceleration the aid
@@ -132,8 +131,8 @@ import numpy as np
 from ...errors import check_choice, check_int, check_range, check_vector
 from ...frames import euler_to_quat, half_angle_coefficients, level_angles, quat_mul, quat_to_euler
 from ..noise_meter import WhiteNoiseMeter
-from .gyro_coast import RECOVERED, RECOVERED_BIAS, GyroCoast
 from ..samples import FORCE_PASS2, MAX_RATE, force_beyond_limit, rate_beyond_limit
+from .gyro_coast import RECOVERED, RECOVERED_BIAS, GyroCoast
 
 log = logging.getLogger(__name__)
 
