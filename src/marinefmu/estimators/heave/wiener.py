@@ -529,8 +529,12 @@ class WienerGroup:
         the outputs are read from)."""
         self.__dict__.update(state)
         if self.sums.ndim == 3:                            # bound
-            for row, axis in zip(self.sums, self.axes):
-                axis.sum_buf = row
+            self._link_axes()
+
+    def _link_axes(self) -> None:
+        """Each axis's ``sum_buf`` a view of its slab of :attr:`sums`."""
+        for row, axis in zip(self.sums, self.axes):
+            axis.sum_buf = row
 
     def bind(self) -> None:
         """Move the axes' running sums into one array (after their ``start`` or ``set_state``)."""
@@ -542,7 +546,7 @@ class WienerGroup:
         for row, axis in zip(self.sums, self.axes):
             if axis.k:             # restored or running: carry its sums (fresh ones are zeros, left untouched)
                 row[:] = axis.sum_buf
-            axis.sum_buf = row
+        self._link_axes()
         self._stale = True
 
     def push(self, values: list[float | None]) -> np.ndarray | None:

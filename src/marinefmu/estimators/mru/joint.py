@@ -216,7 +216,7 @@ class JointMotion:
         self.node_weights = np.zeros((TARGETS, len(self.edges) * CHANNELS + 1))
         self.index = np.zeros(len(self.edges), dtype=np.intp)
         self.flat_nodes = np.ones(len(self.edges) * CHANNELS + 1)      # the gathered sums, then 1
-        self.nodes = self.flat_nodes[:-1].reshape(len(self.edges), CHANNELS)   # a view: the gather lands in it
+        self._link_nodes()
         self.blended = False                        # the joint filter's share has reached 1
 
     def __setstate__(self, state: dict) -> None:
@@ -224,6 +224,11 @@ class JointMotion:
         view's data apart from its base, and the gather would land where the prediction does not
         read)."""
         self.__dict__.update(state)
+        self._link_nodes()
+
+    def _link_nodes(self) -> None:
+        """``nodes``: a (blocks, channels) view of ``flat_nodes`` without its 1, where the gather
+        lands."""
         self.nodes = self.flat_nodes[:-1].reshape(len(self.edges), CHANNELS)
 
     @property
